@@ -1,0 +1,7 @@
+"""``python -m plough`` is the ``plough`` command."""
+
+import sys
+
+from plough.cli import main
+
+sys.exit(main())

@@ -1,0 +1,121 @@
+"""Command line: ``plough analytical ...`` and ``plough mpm SCENE.yaml ...``.
+
+Bad input gives a one-line message naming the parameter and exit code 2, never a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Callable, Sequence
+
+from plough import __version__
+
+
+class _Parser(argparse.ArgumentParser):
+    def error(self, message: str) -> None:  # argparse's own errors: one line, exit 2
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _add_analytical(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "analytical",
+        help="analytical ploughing model (eqs. 1-5 of the paper)",
+        description="Friction and ploughing depth of a rigid sphere sliding on a coated substrate, "
+        "from the analytical model of Mishra et al. (2020), eqs. 1-5. Prints a table in SI and "
+        "practical units.",
+    )
+    p.add_argument("--radius-mm", type=float, required=True, help="sphere radius r in mm")
+    p.add_argument("--load-N", type=float, required=True, help="normal load Fn in N")
+    p.add_argument("--thickness-um", type=float, required=True,
+                   help="coating thickness t in micrometres (0 = uncoated substrate)")
+    p.add_argument("--coating-hardness-MPa", type=float, required=True, help="coating hardness Hc in MPa")
+    p.add_argument("--substrate-hardness-MPa", type=float, required=True,
+                   help="substrate hardness Hs in MPa")
+    p.add_argument("--k1", type=float, default=125.0,
+                   help="effective-hardness factor k1 of eq. 1 (dimensionless, default 125; "
+                   "the paper's thickness sweeps use 12.5)")
+    p.add_argument("--interface", default="proportional",
+                   choices=["proportional", "constant", "boundary_layer"],
+                   help="interface shear model: proportional tau = f H/k0, constant tau = H0/k0, "
+                   "boundary_layer tau = Cp P^np (default proportional)")
+    p.add_argument("--f", type=float, default=1.0,
+                   help="interface factor f in [0, 1] of the proportional model (default 1)")
+    p.add_argument("--H0-MPa", type=float, default=450.0,
+                   help="hardness H0 in MPa of the constant model, tau = H0/k0 (default 450)")
+    p.add_argument("--Cp", type=float, default=0.32,
+                   help="boundary-layer coefficient Cp (tau and P in Pa, default 0.32)")
+    p.add_argument("--np", dest="np_exponent", type=float, default=0.95,
+                   help="boundary-layer exponent np in [0, 1] (default 0.95)")
+    p.add_argument("--correction", default="none", choices=["none", "once", "converged"],
+                   help="normal-load correction of eq. 5 (default none)")
+    p.set_defaults(func=_run_analytical)
+
+
+def _run_analytical(args: argparse.Namespace) -> int:
+    from plough.analytical import RESULT_META, ploughing
+
+    res = ploughing(
+        load_N=args.load_N, radius_m=args.radius_mm * 1e-3, thickness_m=args.thickness_um * 1e-6,
+        coating_hardness_Pa=args.coating_hardness_MPa * 1e6,
+        substrate_hardness_Pa=args.substrate_hardness_MPa * 1e6, k1=args.k1,
+        interface=args.interface, f=args.f, H0_Pa=args.H0_MPa * 1e6, Cp=args.Cp,
+        np_exponent=args.np_exponent, correction=args.correction,
+    ).squeeze()
+    scale = {"m": (1e6, "um"), "m2": (1e12, "um^2"), "Pa": (1e-6, "MPa"), "N": (1.0, "N"), "1": (1.0, "")}
+    print(f"plough {__version__} - analytical ploughing model (Mishra et al. 2020, eqs. 1-5)")
+    print(f"r = {args.radius_mm:g} mm, Fn = {args.load_N:g} N, t = {args.thickness_um:g} um, "
+          f"Hc = {args.coating_hardness_MPa:g} MPa, Hs = {args.substrate_hardness_MPa:g} MPa, "
+          f"k1 = {args.k1:g}, interface = {args.interface}, correction = {args.correction}")
+    for name, value in res.as_dict().items():
+        units, long_name = RESULT_META[name]
+        factor, shown = scale[units]
+        text = f"{int(value)}" if name == "regime" else f"{value * factor:.6g}"
+        print(f"  {name:<13} {text:>14} {shown:<5} {long_name}")
+    return 0
+
+
+def _add_mpm(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("mpm", help="run a 3D MPM ploughing simulation from a scene file",
+                       description="Run the 3D material point method ploughing model on a scene "
+                       "file (YAML) and write the results as netCDF.")
+    p.add_argument("scene", help="scene file (YAML), see examples/")
+    p.add_argument("-o", "--output", required=True, help="netCDF file to write")
+    p.add_argument("--snapshots", default=None, help="directory for particle snapshots (.vtp)")
+    p.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
+    p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.set_defaults(func=_run_mpm)
+
+
+def _run_mpm(args: argparse.Namespace) -> int:
+    try:
+        from plough.mpm.run import run_scene_file
+    except ImportError as exc:  # pragma: no cover - until the solver lands
+        raise ValueError(f"the MPM solver is not available in this build: {exc}") from None
+    run_scene_file(args.scene, args.output, snapshots_dir=args.snapshots, threads=args.threads,
+                   progress=not args.quiet)
+    return 0
+
+
+def build_parser() -> argparse.ArgumentParser:
+    parser = _Parser(prog="plough", description="plough: a hard sphere ploughing through a coated "
+                     "metal sheet - analytical model and 3D MPM solver (Mishra et al., Wear 2020).")
+    parser.add_argument("--version", action="version", version=f"plough {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    _add_analytical(sub)
+    _add_mpm(sub)
+    return parser
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    args = build_parser().parse_args(argv)
+    func: Callable[[argparse.Namespace], int] = args.func
+    try:
+        return func(args)
+    except (ValueError, FileNotFoundError) as exc:
+        print(f"plough {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":  # pragma: no cover
+    sys.exit(main())

@@ -1,0 +1,33 @@
+import subprocess
+import sys
+
+from plough.cli import main
+
+ARGS = ["analytical", "--radius-mm", "0.2", "--load-N", "3", "--thickness-um", "25",
+        "--coating-hardness-MPa", "450", "--substrate-hardness-MPa", "900", "--k1", "12.5"]
+
+
+def test_analytical_table(capsys):
+    assert main(ARGS) == 0
+    out = capsys.readouterr().out
+    assert "mu_pl" in out and "dp" in out
+    line = next(s for s in out.splitlines() if s.split()[0] == "dp")
+    assert abs(float(line.split()[1]) - 8.97297) < 1e-4  # um
+
+
+def test_bad_value_is_one_line_and_exit_2(capsys):
+    args = list(ARGS)
+    args[args.index("--load-N") + 1] = "-3"
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "load_N = -3 N" in err
+
+
+def test_python_m_and_help():
+    out = subprocess.run([sys.executable, "-m", "plough", "analytical", "--help"],
+                         capture_output=True, text=True, check=True).stdout
+    for unit in ("in mm", "in N", "micrometres", "in MPa"):
+        assert unit in out
+    bad = subprocess.run([sys.executable, "-m", "plough", *ARGS, "--interface", "sticky"],
+                         capture_output=True, text=True)
+    assert bad.returncode == 2 and "invalid choice" in bad.stderr
