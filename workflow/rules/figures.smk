@@ -1,0 +1,16 @@
+# Figures: one PNG and one PDF per figure, drawn from the figure's netCDF dataset.
+
+
+rule figure:
+    input:
+        "results/datasets/{figure}.nc",
+        PACKAGE_SOURCES,
+    output:
+        png="results/figures/{figure}.png",
+        pdf="results/figures/{figure}.pdf",
+    log:
+        "logs/figures/{figure}.log",
+    conda:
+        "../envs/plough.yaml"
+    script:
+        "../scripts/plot_figure.py"
