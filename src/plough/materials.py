@@ -357,3 +357,43 @@ def get_material(name: str) -> Material:
         return MATERIALS[name]
     except KeyError:
         raise ValueError(f"material = {name!r} is unknown; known materials: {sorted(MATERIALS)}") from None
+
+
+# ----------------------------------------------------------------------------- plain-Python reference
+def reference_flow_stress(flow: FlowModel, eps_p: float, rate_per_s: float = 0.0,
+                          temperature_K: float = ROOM_TEMPERATURE_K) -> float:
+    """Flow stress (Pa) of eqs. 7.1-7.3 in plain Python: the slow reference for the numba kernels
+    and the source of representative hardness values for scene checks.
+
+    Rate conventions: the BvL thermal-activation term is 0 at zero rate and clipped at 0;
+    Johnson-Cook rates below rate0 give no softening (max(rate, rate0)).
+    """
+    if isinstance(flow, ConstantFlow):
+        return flow.sigma_y_Pa
+    if isinstance(flow, BergstromVanLiempt):
+        e = eps_p + flow.eps0
+        athermal = flow.sigma_f0_Pa + flow.dsigma_m_Pa * (flow.beta * e + (1.0 - math.exp(-flow.omega * e)) ** flow.c)
+        if rate_per_s <= 0.0:
+            return athermal
+        base = 1.0 + BOLTZMANN_EV_PER_K * temperature_K / flow.dG0_eV * math.log(rate_per_s / flow.rate0_per_s)
+        return athermal + flow.sigma_v0_Pa * max(base, 0.0) ** flow.m
+    if isinstance(flow, JohnsonCook):
+        strain = flow.A_Pa + flow.B_Pa * eps_p**flow.p if eps_p > 0 else flow.A_Pa
+        rate = 1.0 + flow.C * math.log(max(rate_per_s, flow.rate0_per_s) / flow.rate0_per_s)
+        theta = min(max((temperature_K - flow.T0_K) / (flow.Tm_K - flow.T0_K), 0.0), 1.0)
+        return strain * rate * (1.0 - theta**flow.q)
+    if isinstance(flow, CoatingPowerLaw):
+        return flow.sigma_y0_Pa * (1.0 + flow.E_Pa * eps_p / flow.sigma_y0_Pa) ** flow.n
+    raise TypeError(f"unknown flow model {flow!r}")
+
+
+#: Representative plastic strain of an indentation (Tabor): H ~ 3 sigma_y(0.08).
+TABOR_STRAIN = 0.08
+
+
+def representative_hardness(material: Material) -> float:
+    """Hardness estimate H = 3 sigma_y(eps = 0.08, static rate, room temperature), in Pa.
+
+    For the constant-flow rigid-plastic materials this is exactly the Table-2 hardness.
+    """
+    return 3.0 * reference_flow_stress(material.flow, TABOR_STRAIN, 0.0, ROOM_TEMPERATURE_K)
