@@ -1,0 +1,201 @@
+"""Contact of the material with the rigid analytic sphere, on the grid (model.md section 2, eq. 8).
+
+A node inside the sphere whose velocity approaches the sphere gets the sphere's normal velocity
+(impenetrability). The tangential velocity change is a traction-limited impulse:
+
+    J_t <= tau * A_i * dt,     A_i = min(F_n,i / P_i, dx^2)
+
+with P_i = -n . sigma_i . n the local contact pressure from the mass-averaged stress of the
+particles touching node i, and the interface shear strength
+
+    proportional:    tau = f * kappa                 (kappa = sigma_y / sqrt(3) of the material)
+    constant:        tau = H0 / k0
+    boundary layer:  tau = Cp * P^np                 (P in Pa, Table 5)
+
+always capped at kappa (never above the contacting material's shear strength) and never larger
+than the impulse that stops the slip (so the slip never reverses). The reaction on the sphere
+is minus the impulses, split into the normal-traction (ploughing) and interface-shear parts.
+"""
+
+from __future__ import annotations
+
+import math
+
+from numba import njit
+
+from plough.mpm.constitutive import mixed_flow_stress
+from plough.mpm.shape import bspline2
+
+INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
+SQRT3 = math.sqrt(3.0)
+
+# outputs of sphere_contact
+OUT_FN = 0  # 0:3 force on the sphere from normal impulses, N
+OUT_FT = 3  # 3:6 force on the sphere from tangential (interface) impulses, N
+OUT_DISSIPATION = 6  # energy dissipated by interface slip in this step, J
+OUT_IMPACT = 7  # kinetic energy lost by the inelastic normal projection, J
+OUT_WORK = 8  # work done by the sphere on the material this step, J
+OUT_NODES = 9  # number of contact nodes
+OUT_AREA_XY = 10  # contact area projected on the xy plane, m^2
+N_OUT = 11
+
+
+@njit(cache=True)
+def _inside_box(origin, dx, shape, centre, radius):
+    """Index ranges of the grid nodes that can lie inside the sphere."""
+    lo = [0, 0, 0]
+    hi = [0, 0, 0]
+    for d in range(3):
+        lo[d] = max(int(math.floor((centre[d] - radius - origin[d]) / dx)), 0)
+        hi[d] = min(int(math.ceil((centre[d] + radius - origin[d]) / dx)), shape[d] - 1)
+    return lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
+
+
+@njit(cache=True)
+def scatter_contact_stress(x, stress, mass, eps_p, temperature, mat_a, mat_b, frac_a, table, near, origin, dx,
+                           shape, centre, radius, cbuf):
+    """Mass-weighted stress and shear strength of the particles near the sphere onto its inner nodes.
+
+    Reads particle x, stress, mass, eps_p, temperature, materials and ``near`` (set by g2p).
+    Writes cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m for
+    nodes inside the sphere. Serial: few particles touch the sphere. ``sphere_contact`` consumes
+    and re-zeroes these entries.
+    """
+    ny, nz = shape[1], shape[2]
+    inv_dx = 1.0 / dx
+    r2 = radius * radius
+    for p in range(x.shape[0]):
+        if near[p] == 0:
+            continue
+        kappa = mixed_flow_stress(table[mat_a[p]], table[mat_b[p]], frac_a[p], eps_p[p], 0.0,
+                                  temperature[p]) / SQRT3
+        gx = (x[p, 0] - origin[0]) * inv_dx
+        gy = (x[p, 1] - origin[1]) * inv_dx
+        gz = (x[p, 2] - origin[2]) * inv_dx
+        bx, wx0, wx1, wx2 = bspline2(gx)
+        by, wy0, wy1, wy2 = bspline2(gy)
+        bz, wz0, wz1, wz2 = bspline2(gz)
+        for a in range(3):
+            wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
+            px = origin[0] + (bx + a) * dx - centre[0]
+            for b in range(3):
+                wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
+                py = origin[1] + (by + b) * dx - centre[1]
+                for cc in range(3):
+                    pz = origin[2] + (bz + cc) * dx - centre[2]
+                    if px * px + py * py + pz * pz >= r2:
+                        continue
+                    wm = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2)) * mass[p]
+                    node = ((bx + a) * ny + (by + b)) * nz + bz + cc
+                    for k in range(6):
+                        cbuf[node, k] += wm * stress[p, k]
+                    cbuf[node, 6] += wm * kappa
+                    cbuf[node, 7] += wm
+
+
+@njit(cache=True)
+def interface_shear(model, iparams, pressure, kappa):
+    """Interface shear strength tau (Pa) of eq. 8 at one node, capped at kappa."""
+    if model == INTERFACE_PROPORTIONAL:
+        tau = iparams[0] * kappa
+    elif model == INTERFACE_CONSTANT:
+        tau = iparams[0]
+    else:
+        tau = iparams[0] * max(pressure, 0.0) ** iparams[1]
+    return min(tau, kappa)
+
+
+@njit(cache=True)
+def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sphere, dt, model, iparams, out):
+    """Impose the sphere on the nodes inside it and measure the reaction.
+
+    Reads grid_m, cbuf (from scatter_contact_stress; its entries are zeroed here). Writes
+    grid_v of contact nodes and out[0:N_OUT] (see the OUT_* indices).
+    """
+    ny, nz = shape[1], shape[2]
+    for k in range(N_OUT):
+        out[k] = 0.0
+    i0, i1, j0, j1, k0, k1 = _inside_box(origin, dx, shape, centre, radius)
+    r2 = radius * radius
+    dx2 = dx * dx
+    for i in range(i0, i1 + 1):
+        px = origin[0] + i * dx - centre[0]
+        for j in range(j0, j1 + 1):
+            py = origin[1] + j * dx - centre[1]
+            for kk in range(k0, k1 + 1):
+                pz = origin[2] + kk * dx - centre[2]
+                d2 = px * px + py * py + pz * pz
+                if d2 >= r2:
+                    continue
+                node = (i * ny + j) * nz + kk
+                cw = cbuf[node, 7]
+                s0 = cbuf[node, 0]
+                s1 = cbuf[node, 1]
+                s2 = cbuf[node, 2]
+                s3 = cbuf[node, 3]
+                s4 = cbuf[node, 4]
+                s5 = cbuf[node, 5]
+                kap = cbuf[node, 6]
+                for k in range(8):
+                    cbuf[node, k] = 0.0
+                m = grid_m[node]
+                if m <= 0.0:
+                    continue
+                dist = math.sqrt(d2)
+                if dist <= 0.0:
+                    continue
+                n0 = px / dist
+                n1 = py / dist
+                n2 = pz / dist
+                vb0 = grid_v[node, 0]
+                vb1 = grid_v[node, 1]
+                vb2 = grid_v[node, 2]
+                r0 = vb0 - v_sphere[0]
+                r1 = vb1 - v_sphere[1]
+                r2v = vb2 - v_sphere[2]
+                vn = r0 * n0 + r1 * n1 + r2v * n2
+                if vn >= 0.0:
+                    continue  # separating: no contact force
+                jn = -m * vn
+                t0 = r0 - vn * n0
+                t1 = r1 - vn * n1
+                t2 = r2v - vn * n2
+                vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+                if cw > 0.0:
+                    inv = 1.0 / cw
+                    pressure = -(n0 * n0 * s0 + n1 * n1 * s1 + n2 * n2 * s2
+                                 + 2.0 * (n1 * n2 * s3 + n0 * n2 * s4 + n0 * n1 * s5)) * inv
+                    kappa = kap * inv
+                else:
+                    pressure = 0.0
+                    kappa = 0.0
+                tau = interface_shear(model, iparams, pressure, kappa)
+                area = dx2 if pressure <= 0.0 else min(jn / (dt * pressure), dx2)
+                jt = 0.0
+                if vt > 0.0:
+                    jt = min(m * vt, tau * area * dt)
+                    scale = 1.0 - jt / (m * vt)
+                else:
+                    scale = 0.0
+                va0 = v_sphere[0] + scale * t0
+                va1 = v_sphere[1] + scale * t1
+                va2 = v_sphere[2] + scale * t2
+                grid_v[node, 0] = va0
+                grid_v[node, 1] = va1
+                grid_v[node, 2] = va2
+                # reaction on the sphere: minus the impulses on the material, per unit time
+                out[OUT_FN + 0] -= jn * n0 / dt
+                out[OUT_FN + 1] -= jn * n1 / dt
+                out[OUT_FN + 2] -= jn * n2 / dt
+                if vt > 0.0:
+                    out[OUT_FT + 0] += jt * t0 / vt / dt
+                    out[OUT_FT + 1] += jt * t1 / vt / dt
+                    out[OUT_FT + 2] += jt * t2 / vt / dt
+                vt_after = scale * vt
+                out[OUT_DISSIPATION] += 0.5 * jt * (vt + vt_after)
+                out[OUT_IMPACT] += 0.5 * m * vn * vn
+                out[OUT_WORK] += m * ((va0 - vb0) * v_sphere[0] + (va1 - vb1) * v_sphere[1]
+                                      + (va2 - vb2) * v_sphere[2])
+                out[OUT_NODES] += 1.0
+                if n2 < 0.0:
+                    out[OUT_AREA_XY] += area * (-n2)

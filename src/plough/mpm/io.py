@@ -1,0 +1,202 @@
+"""Outputs of an MPM run: the results dataset, residual groove profiles, particle snapshots.
+
+Steady-state results are named as in the analytical model (``mu``, ``mu_pl``, ``mu_sh``, ``dp``)
+plus ``dg`` (groove depth below the original surface), ``hpu`` (pile-up height above it) and
+``penetration`` (depth of the sphere's lowest point under load), so the two compare directly:
+mu = mean Fx / mean Fz over the steady window, mu_pl and mu_sh the same with the normal-traction
+and interface-shear parts of Fx; dp = dg + hpu from the residual cross-sections (Fig. 14c).
+
+Snapshots are VTK XML PolyData (.vtp) files, which ParaView and OVITO open.
+"""
+
+from __future__ import annotations
+
+import base64
+import json
+import time
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from plough.io import provenance_attrs, write_netcdf_atomic
+from plough.mpm.particles import Particles
+from plough.mpm.scene import Scene
+
+SERIES_META = {
+    "Fx": ("N", "friction force on the sphere (resisting the sliding, positive)"),
+    "Fy": ("N", "lateral force on the sphere"),
+    "Fz": ("N", "normal force on the sphere (upward reaction, positive)"),
+    "Fx_pl": ("N", "friction force from normal traction (ploughing part)"),
+    "Fx_sh": ("N", "friction force from interface shear (shear part)"),
+    "Fz_pl": ("N", "normal force from normal traction"),
+    "Fz_sh": ("N", "normal force from interface shear"),
+    "depth": ("m", "depth of the sphere's lowest point below the original surface"),
+    "particle_penetration": ("m", "deepest penetration of a particle centre into the sphere"),
+    "contact_area_xy": ("m2", "contact area projected on the sliding plane"),
+    "external_work": ("J", "work done by the sphere on the block (cumulative)"),
+    "plastic_work": ("J", "plastic work (cumulative)"),
+    "elastic_energy": ("J", "elastic strain energy"),
+    "kinetic_energy": ("J", "kinetic energy (mass-scaled)"),
+    "interface_dissipation": ("J", "energy dissipated by interface slip (cumulative)"),
+    "contact_impact_loss": ("J", "kinetic energy lost in the inelastic normal contact projection (cumulative)"),
+    "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),
+    "time": ("s", "simulated time"),
+}
+STEADY_META = {
+    "mu": ("1", "friction coefficient, mean Fx / mean Fz over the steady window"),
+    "mu_pl": ("1", "ploughing part of the friction coefficient"),
+    "mu_sh": ("1", "interface-shear part of the friction coefficient"),
+    "Fz_mean": ("N", "mean normal force over the steady window"),
+    "Fx_mean": ("N", "mean friction force over the steady window"),
+    "penetration": ("m", "mean depth of the sphere's lowest point under load over the steady window"),
+    "dg": ("m", "residual groove depth below the original surface"),
+    "hpu": ("m", "residual pile-up height above the original surface"),
+    "dp": ("m", "ploughing depth dp = dg + hpu"),
+    "max_particle_penetration": ("m", "deepest penetration of a particle centre into the sphere (whole run)"),
+}
+
+
+def steady_window_mask(slid_m: np.ndarray, scene: Scene) -> np.ndarray:
+    lo, hi = scene.outputs.steady_window
+    d = scene.sliding.distance_m
+    return (slid_m >= lo * d - 1e-12) & (slid_m <= hi * d + 1e-12)
+
+
+def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float) -> tuple:
+    """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
+    h = scene.discretisation.particle_size_m
+    x0 = scene.start_x_m
+    d = scene.sliding.distance_m
+    lo, _ = scene.outputs.steady_window
+    x_lo = x0 + lo * d
+    x_hi = sphere_x_end - 2.5 * contact_radius
+    if x_hi <= x_lo:
+        x_lo = x0 + 2.0 * contact_radius
+    if x_hi <= x_lo:
+        raise ValueError("the slide is too short to measure a residual groove behind the sphere "
+                         "(sliding.distance_m must exceed ~5 contact radii)")
+    sections = np.linspace(x_lo, x_hi, scene.outputs.profile_sections)
+    y_max = scene.domain.radius_m
+    y_min = 0.0 if scene.domain.symmetric else -y_max
+    edges = np.arange(y_min, y_max + 0.5 * h, h)
+    centres = 0.5 * (edges[1:] + edges[:-1])
+    top = p.x[:, 2] + 0.5 * h * np.cbrt(p.J)  # the top face of each particle's cube
+    profiles = []
+    for xs in sections:
+        band = np.abs(p.x[:, 0] - xs) < 0.5 * h
+        idx = np.clip(np.digitize(p.x[band, 1], edges) - 1, 0, centres.size - 1)
+        z = np.full(centres.size, -np.inf)
+        np.maximum.at(z, idx, top[band])
+        profiles.append(z)
+    prof = np.array(profiles)
+    prof[~np.isfinite(prof)] = np.nan
+    return centres, np.nanmean(prof, axis=0), sections
+
+
+def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarray, p: Particles,
+                  sphere_x_end: float, cost: dict[str, float], max_penetration: float) -> xr.Dataset:
+    """The results of one run as an xarray Dataset with units, long names and provenance."""
+    mask = steady_window_mask(slid_m, scene)
+    if mask.sum() < 3:
+        raise ValueError("fewer than 3 records in the steady window; raise outputs.records")
+    Fx, Fz = series["Fx"][mask].mean(), series["Fz"][mask].mean()
+    a_exp, _ = scene.expected_contact()
+    y, z_top, sections = residual_profiles(p, scene, sphere_x_end, a_exp)
+    near_track = np.abs(y) <= 1.5 * a_exp
+    dg = float(max(-np.nanmin(z_top[near_track]), 0.0))
+    hpu = float(max(np.nanmax(z_top), 0.0))
+    steady = {
+        "mu": Fx / Fz, "mu_pl": series["Fx_pl"][mask].mean() / Fz, "mu_sh": series["Fx_sh"][mask].mean() / Fz,
+        "Fz_mean": Fz, "Fx_mean": Fx, "penetration": series["depth"][mask].mean(), "dg": dg, "hpu": hpu,
+        "dp": dg + hpu, "max_particle_penetration": max_penetration,
+    }
+    ds = xr.Dataset(
+        {name: (("record",), series[name], {"units": u, "long_name": ln}) for name, (u, ln) in SERIES_META.items()},
+        coords={"sliding_distance": (("record",), slid_m, {"units": "m", "long_name": "sliding distance"}),
+                "y": (("y",), y, {"units": "m", "long_name": "lateral position across the groove"}),
+                "section_x": (("section",), sections, {"units": "m", "long_name": "x of the residual cross-sections"})},
+    )
+    ds["profile_z"] = (("y",), z_top, {"units": "m", "long_name": "residual surface height, mean of the sections",
+                                       "allow_missing": 1})
+    ds["in_steady_window"] = (("record",), mask, {"long_name": "record lies in the steady window"})
+    for name, value in steady.items():
+        u, ln = STEADY_META[name]
+        ds[name] = ((), float(value), {"units": u, "long_name": ln})
+    for name, value in cost.items():
+        ds.attrs[f"cost_{name}"] = value
+    ds.attrs.update(provenance_attrs(scene.to_dict(), key="scene"))
+    ds.attrs["steady_window"] = json.dumps(list(scene.outputs.steady_window))
+    ds.attrs["coating_representation"] = coating_representation(scene)
+    return ds
+
+
+def coating_representation(scene: Scene) -> str:
+    """How the coating was discretised (said in the output, never silently rounded)."""
+    if not scene.layers.coated:
+        return "uncoated"
+    h = scene.discretisation.particle_size_m
+    t = scene.layers.coating_thickness_m
+    full, rest = divmod(t, h)
+    if rest < 1e-9 * h:
+        return f"{int(full)} full particle layer(s) of coating (t/h = {t / h:g})"
+    return (f"{int(full)} full particle layer(s) of coating plus one layer that straddles the interface and carries "
+            f"the volume-weighted mix (coating fraction {rest / h:.3g}); t/h = {t / h:.3g}")
+
+
+def write_result(ds: xr.Dataset, path: str | Path) -> Path:
+    return write_netcdf_atomic(ds, path)
+
+
+# ----------------------------------------------------------------------------- snapshots
+def _data_array(name: str, arr: np.ndarray, ncomp: int) -> str:
+    raw = np.ascontiguousarray(arr, dtype=np.float32).tobytes()
+    header = np.array([len(raw)], dtype=np.uint32).tobytes()
+    payload = base64.b64encode(header).decode() + base64.b64encode(raw).decode()
+    return (f'<DataArray type="Float32" Name="{name}" NumberOfComponents="{ncomp}" format="binary">'
+            f"{payload}</DataArray>")
+
+
+def write_snapshot(p: Particles, path: str | Path, sphere_centre: np.ndarray, sphere_radius: float,
+                   coating_row: int = -1) -> Path:
+    """Particles as VTK XML PolyData (.vtp): position, material, plastic strain, temperature, stress."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    n = p.n
+    sig = p.stress
+    pressure = -(sig[:, 0] + sig[:, 1] + sig[:, 2]) / 3.0
+    s = sig[:, :3] + pressure[:, None]
+    mises = np.sqrt(1.5 * (s**2).sum(1) + 3.0 * (sig[:, 3:] ** 2).sum(1))
+    coating_fraction = np.where(p.mat_a == coating_row, p.frac_a, 0.0)
+    conn = np.arange(n, dtype=np.int32)
+    xml = [
+        '<?xml version="1.0"?>',
+        '<VTKFile type="PolyData" version="0.1" byte_order="LittleEndian" header_type="UInt32">',
+        "<PolyData>",
+        f'<Piece NumberOfPoints="{n}" NumberOfVerts="{n}" NumberOfLines="0" NumberOfStrips="0" NumberOfPolys="0">',
+        "<PointData>",
+        _data_array("material", p.mat_a.astype(np.float32), 1),
+        _data_array("coating_fraction", coating_fraction, 1),
+        _data_array("plastic_strain", p.eps_p, 1),
+        _data_array("temperature_K", p.temperature, 1),
+        _data_array("von_mises_Pa", mises, 1),
+        _data_array("pressure_Pa", pressure, 1),
+        _data_array("stress_Pa", sig, 6),
+        _data_array("velocity_m_s", p.v, 3),
+        "</PointData>",
+        "<Points>", _data_array("Points", p.x, 3), "</Points>",
+        "<Verts>",
+        '<DataArray type="Int32" Name="connectivity" format="binary">'
+        + base64.b64encode(np.array([conn.nbytes], np.uint32).tobytes()).decode()
+        + base64.b64encode(conn.tobytes()).decode() + "</DataArray>",
+        '<DataArray type="Int32" Name="offsets" format="binary">'
+        + base64.b64encode(np.array([conn.nbytes], np.uint32).tobytes()).decode()
+        + base64.b64encode((conn + 1).tobytes()).decode() + "</DataArray>",
+        "</Verts>",
+        "</Piece>",
+        "</PolyData>",
+        f"<!-- sphere centre {sphere_centre.tolist()} m, radius {sphere_radius} m, written {time.strftime('%F %T')} -->",
+        "</VTKFile>",
+    ]
+    path.write_text("\n".join(xml))
+    return path

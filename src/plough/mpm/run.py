@@ -1,0 +1,132 @@
+"""Run a scene: the time loop with recording, progress, snapshots, and the results dataset.
+
+``simulate(scene)`` returns an ``xarray.Dataset``; ``run_scene_file`` is the command-line path
+(scene YAML in, netCDF out, written atomically: a failed run leaves no result file).
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import numba
+import numpy as np
+import xarray as xr
+
+from plough.mpm import contact, io, solver, transfers
+from plough.mpm.scene import Scene
+
+
+class _Recorder:
+    """Interval means of the per-step forces and snapshots of the energies, every ``every`` steps."""
+
+    def __init__(self, every: int) -> None:
+        self.every = max(int(every), 1)
+        self.rows: list[dict[str, float]] = []
+        self.slid: list[float] = []
+        self._sum = np.zeros(7)
+        self._count = 0
+        self.max_penetration = -np.inf
+
+    def add(self, s: solver.State, c: solver.Constants) -> None:
+        out = s.work.contact_out
+        fn, ft = out[contact.OUT_FN:contact.OUT_FN + 3], out[contact.OUT_FT:contact.OUT_FT + 3]
+        self._sum += np.array([-(fn[0] + ft[0]), fn[1] + ft[1], fn[2] + ft[2], -fn[0], -ft[0], fn[2], ft[2]])
+        self._count += 1
+        pen = float(s.work.acc[:, transfers.ACC_PENETRATION].max())
+        self.max_penetration = max(self.max_penetration, pen)
+        if self._count >= self.every:
+            self.flush(s, c, pen)
+
+    def flush(self, s: solver.State, c: solver.Constants, pen: float) -> None:
+        if self._count == 0:
+            return
+        m = self._sum / self._count
+        acc, w = s.work.acc, s.work
+        self.rows.append({
+            "Fx": m[0], "Fy": m[1], "Fz": m[2], "Fx_pl": m[3], "Fx_sh": m[4], "Fz_pl": m[5], "Fz_sh": m[6],
+            "depth": c.sphere_radius - s.sphere.centre[2],
+            "particle_penetration": pen, "contact_area_xy": float(w.contact_out[contact.OUT_AREA_XY]),
+            "external_work": w.external_work, "plastic_work": w.plastic_work,
+            "elastic_energy": float(acc[:, transfers.ACC_ELASTIC].sum()),
+            "kinetic_energy": float(acc[:, transfers.ACC_KINETIC].sum()),
+            "interface_dissipation": w.interface_dissipation, "contact_impact_loss": w.contact_impact_loss,
+            "heat": w.heat, "time": s.time,
+        })
+        self.slid.append(s.sphere.slid_m if s.sphere.phase in ("slide", "done") else 0.0)
+        self._sum[:] = 0.0
+        self._count = 0
+
+    def series(self) -> tuple[dict[str, np.ndarray], np.ndarray]:
+        keys = self.rows[0].keys()
+        return {k: np.array([r[k] for r in self.rows]) for k in keys}, np.array(self.slid)
+
+
+def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path | None = None,
+             threads: int | None = None) -> xr.Dataset:
+    """Run the MPM ploughing simulation of ``scene`` and return its results dataset."""
+    if threads is not None:
+        numba.set_num_threads(threads)
+    wall0 = time.perf_counter()
+    state, const = solver.init(scene)
+    max_press_steps = int(10 * scene.sphere.radius_m / (const.press_speed * const.dt))
+    rec = _Recorder(const.steps_slide / scene.outputs.records)
+    n_snap = scene.outputs.snapshots
+    snap_every = scene.sliding.distance_m / n_snap if n_snap else np.inf
+    next_snap = 0.0
+    coating_row = 0 if scene.layers.coated else -1
+    bar = _progress(scene, enabled=progress)
+    try:
+        while state.sphere.phase != "done":
+            solver.step(state, const)
+            rec.add(state, const)
+            if state.sphere.phase in ("press", "settle") and state.step > max_press_steps:
+                raise solver.SimulationError(
+                    f"the sphere did not reach the load in {state.step} steps: load_N = {scene.load_N:g} N may be "
+                    "too high for the domain, or the contact is lost")
+            if snapshots_dir is not None and state.sphere.slid_m >= next_snap and state.sphere.phase == "slide":
+                io.write_snapshot(state.particles, Path(snapshots_dir) / f"{scene.name}_{int(round(next_snap * 1e6)):05d}um.vtp",
+                                  state.sphere.centre, const.sphere_radius, coating_row)
+                next_snap += snap_every
+            if bar is not None and state.step % 20 == 0:
+                _update_bar(bar, state, rec)
+    finally:
+        if bar is not None:
+            bar.close()
+    rec.flush(state, const, float(state.work.acc[:, transfers.ACC_PENETRATION].max()))
+    if snapshots_dir is not None:
+        io.write_snapshot(state.particles, Path(snapshots_dir) / f"{scene.name}_final.vtp", state.sphere.centre,
+                          const.sphere_radius, coating_row)
+    wall = time.perf_counter() - wall0
+    series, slid = rec.series()
+    n = state.particles.n
+    cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
+            "dt_s": const.dt, "particle_steps_per_s": n * state.step / wall, "threads": numba.get_num_threads()}
+    return io.build_dataset(scene, series, slid, state.particles, state.sphere.centre[0], cost,
+                            rec.max_penetration)
+
+
+def _progress(scene: Scene, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=round(scene.sliding.distance_m * 1e6, 1), unit="um", desc=f"{scene.name}: pressing",
+                bar_format="{desc} |{bar}| {n:.0f}/{total:.0f} um slid [{elapsed}<{remaining}] {postfix}")
+
+
+def _update_bar(bar, state: solver.State, rec: _Recorder) -> None:
+    slid_um = round(state.sphere.slid_m * 1e6, 1)
+    bar.set_description_str(f"{state.sphere.phase}", refresh=False)
+    if rec.rows:
+        last = rec.rows[-1]
+        bar.set_postfix_str(f"Fx={last['Fx']:.3g} N Fz={last['Fz']:.3g} N step={state.step}", refresh=False)
+    bar.update(slid_um - bar.n)
+
+
+def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir: str | Path | None = None,
+                   threads: int | None = None, progress: bool = True) -> Path:
+    """Read a scene YAML, simulate, write the netCDF atomically (nothing is written on failure)."""
+    scene = Scene.from_yaml(Path(scene_path))
+    ds = simulate(scene, progress=progress, snapshots_dir=snapshots_dir, threads=threads)
+    return io.write_result(ds, output)

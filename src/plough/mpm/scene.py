@@ -1,0 +1,396 @@
+"""A ploughing scene as data: frozen dataclasses validated on construction (model.md section 2).
+
+Geometry of Table 1: the substrate is a half cylinder with its axis along x (the sliding
+direction), flat face up at z = 0; the coating is the material with initial z > -t. A rigid
+sphere of radius r is pressed with a normal load and slid along x. With ``symmetric`` the
+problem is cut at the mirror plane y = 0 and only y >= 0 is simulated.
+
+A scene converts to and from a plain dict / YAML file. Keys carry their unit; on reading, keys
+ending in ``_um``, ``_mm``, ``_MPa`` or ``_GPa`` are converted to the SI field (``_m``, ``_Pa``),
+so a scene file may say ``radius_um: 200`` for the field ``radius_m``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import asdict, dataclass, field, fields, replace
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from plough.materials import (
+    ROOM_TEMPERATURE_K,
+    BoundaryLayerShear,
+    ConstantShear,
+    Interface,
+    Material,
+    ProportionalShear,
+    get_material,
+    representative_hardness,
+    interface_from_dict,
+    interface_to_dict,
+    rigid_plastic,
+)
+
+_UNIT_SUFFIXES = {"_um": ("_m", 1e-6), "_mm": ("_m", 1e-3), "_MPa": ("_Pa", 1e6), "_GPa": ("_Pa", 1e9)}
+
+#: Largest CFL number accepted: explicit MPM with quadratic B-splines is stable below ~1 for
+#: the elastic wave; contact and plasticity need margin (issue 5 measures the practical limit).
+CFL_MAX = 1.0
+
+
+def _to_si(d: dict[str, Any]) -> dict[str, Any]:
+    out: dict[str, Any] = {}
+    for key, value in d.items():
+        for suffix, (si_suffix, factor) in _UNIT_SUFFIXES.items():
+            if key.endswith(suffix):
+                new = key[: -len(suffix)] + si_suffix
+                if new in d:
+                    raise ValueError(f"both {key!r} and {new!r} given; give one")
+                out[new] = None if value is None else float(value) * factor
+                break
+        else:
+            out[key] = value
+    return out
+
+
+def _coerce(value: Any, type_name: str, where: str) -> Any:
+    """YAML 1.1 reads 1.0e6 as a string: convert numbers by the field's declared type."""
+    if value is None or type_name not in ("float", "int", "float | None"):
+        return value
+    try:
+        number = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where} = {value!r} is not a number") from None
+    if type_name == "int":
+        if number != int(number):
+            raise ValueError(f"{where} = {value!r} is not an integer")
+        return int(number)
+    return number
+
+
+def _from_dict(cls: type, d: dict[str, Any] | None, where: str) -> Any:
+    d = _to_si(dict(d or {}))
+    types = {f.name: str(f.type) for f in fields(cls)}
+    unknown = set(d) - set(types)
+    if unknown:
+        raise ValueError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(types)}")
+    return cls(**{k: _coerce(v, types[k], f"{where}.{k}") for k, v in d.items()})
+
+
+def _finite_positive(where: str, name: str, value: float, unit: str = "") -> None:
+    if not (isinstance(value, int | float) and math.isfinite(value) and value > 0):
+        raise ValueError(f"{where}.{name} = {value!r} {unit} is not allowed; it must be > 0".replace("  ", " "))
+
+
+# ----------------------------------------------------------------------------- parts
+@dataclass(frozen=True)
+class Sphere:
+    """The rigid indenter: an exact analytic sphere."""
+
+    radius_m: float = 200e-6
+
+    def __post_init__(self) -> None:
+        _finite_positive("sphere", "radius_m", self.radius_m, "m")
+
+
+@dataclass(frozen=True)
+class Layers:
+    """Coating (thickness, material) on a substrate. ``coating_thickness_m = 0``: uncoated."""
+
+    substrate: Material
+    coating: Material | None = None
+    coating_thickness_m: float = 0.0
+
+    def __post_init__(self) -> None:
+        t = self.coating_thickness_m
+        if not (isinstance(t, int | float) and math.isfinite(t) and t >= 0):
+            raise ValueError(f"layers.coating_thickness_m = {t!r} m is not allowed; it must be >= 0")
+        if t > 0 and self.coating is None:
+            raise ValueError("layers.coating is missing although coating_thickness_m > 0")
+        for name in ("substrate", "coating"):
+            m = getattr(self, name)
+            if m is not None and not isinstance(m, Material):
+                raise ValueError(f"layers.{name} = {m!r} is not a Material")
+
+    @property
+    def coated(self) -> bool:
+        return self.coating_thickness_m > 0
+
+    @property
+    def materials(self) -> tuple[Material, ...]:
+        return (self.coating, self.substrate) if self.coated else (self.substrate,)
+
+
+@dataclass(frozen=True)
+class Domain:
+    """The simulated block: a half cylinder of radius ``radius_m`` and length ``length_m``."""
+
+    radius_m: float = 200e-6
+    length_m: float = 1000e-6
+    symmetric: bool = True
+
+    def __post_init__(self) -> None:
+        _finite_positive("domain", "radius_m", self.radius_m, "m")
+        _finite_positive("domain", "length_m", self.length_m, "m")
+        if not isinstance(self.symmetric, bool):
+            raise ValueError(f"domain.symmetric = {self.symmetric!r} must be true or false")
+
+
+@dataclass(frozen=True)
+class Sliding:
+    """Path of the sphere: press to the load (or to a depth), then slide ``distance_m`` along x.
+
+    ``speed_m_s`` is the simulated sliding speed; ``experiment_speed_m_s`` the physical one, used
+    to evaluate strain-rate terms at the physical rate (rate_phys = rate_sim * v_exp / v_sim).
+    ``control`` is ``load`` (the sphere's height floats so that Fz = load) or ``displacement``
+    (the sphere is held at ``depth_m`` below the original surface).
+    """
+
+    distance_m: float = 600e-6
+    speed_m_s: float = 0.1
+    experiment_speed_m_s: float = 1e-3
+    control: str = "load"
+    depth_m: float | None = None
+    press_speed_fraction: float = 0.25
+
+    def __post_init__(self) -> None:
+        _finite_positive("sliding", "distance_m", self.distance_m, "m")
+        _finite_positive("sliding", "speed_m_s", self.speed_m_s, "m/s")
+        _finite_positive("sliding", "experiment_speed_m_s", self.experiment_speed_m_s, "m/s")
+        if self.control not in ("load", "displacement"):
+            raise ValueError(f"sliding.control = {self.control!r} is unknown; allowed: load, displacement")
+        if self.control == "displacement":
+            if self.depth_m is None:
+                raise ValueError("sliding.depth_m is required when sliding.control = displacement")
+            _finite_positive("sliding", "depth_m", self.depth_m, "m")
+        if not (0 < self.press_speed_fraction <= 1):
+            raise ValueError(f"sliding.press_speed_fraction = {self.press_speed_fraction!r} is outside (0, 1]")
+
+
+@dataclass(frozen=True)
+class Discretisation:
+    """Particle size h (edge of the cube a particle fills), cells, time step and mass scaling."""
+
+    particle_size_m: float = 10e-6
+    particles_per_cell: int = 2
+    cfl: float = 0.3
+    mass_scaling: float = 1e6
+
+    def __post_init__(self) -> None:
+        _finite_positive("discretisation", "particle_size_m", self.particle_size_m, "m")
+        if self.particles_per_cell not in (1, 2, 3, 4):
+            raise ValueError(f"discretisation.particles_per_cell = {self.particles_per_cell!r} "
+                             "(per direction) is outside the allowed range 1..4")
+        if not (0 < self.cfl <= CFL_MAX):
+            raise ValueError(f"discretisation.cfl = {self.cfl!r} is outside the stable range (0, {CFL_MAX}]")
+        if not (math.isfinite(self.mass_scaling) and self.mass_scaling >= 1):
+            raise ValueError(f"discretisation.mass_scaling = {self.mass_scaling!r} must be >= 1")
+
+    @property
+    def cell_size_m(self) -> float:
+        return self.particle_size_m * self.particles_per_cell
+
+
+@dataclass(frozen=True)
+class Outputs:
+    """What a run records. ``steady_window`` is the fraction of the slide averaged for the
+    steady-state results (paper: the last half, 0.3-0.6 mm of 0.6 mm)."""
+
+    steady_window: tuple[float, float] = (0.5, 1.0)
+    records: int = 400
+    snapshots: int = 0
+    profile_sections: int = 5
+    taylor_quinney: float = 0.9
+    initial_temperature_K: float = ROOM_TEMPERATURE_K
+
+    def __post_init__(self) -> None:
+        lo, hi = self.steady_window
+        if not (0 <= lo < hi <= 1):
+            raise ValueError(f"outputs.steady_window = {self.steady_window!r} must satisfy 0 <= start < end <= 1")
+        if self.records < 10:
+            raise ValueError(f"outputs.records = {self.records!r} must be >= 10")
+        if self.snapshots < 0:
+            raise ValueError(f"outputs.snapshots = {self.snapshots!r} must be >= 0")
+        if self.profile_sections < 1:
+            raise ValueError(f"outputs.profile_sections = {self.profile_sections!r} must be >= 1")
+        if not (0 <= self.taylor_quinney <= 1):
+            raise ValueError(f"outputs.taylor_quinney = {self.taylor_quinney!r} is outside [0, 1]")
+
+
+# ----------------------------------------------------------------------------- materials in files
+def material_from_spec(spec: Any, *, coating: bool, where: str) -> Material:
+    """A material from a scene file: a name, ``{rigid_plastic_hardness_Pa: H}`` or a full dict."""
+    if isinstance(spec, Material):
+        return spec
+    if isinstance(spec, str):
+        try:
+            return get_material(spec)
+        except ValueError as exc:
+            raise ValueError(f"{where}: {exc}") from None
+    if isinstance(spec, dict):
+        d = _to_si(spec)
+        if "rigid_plastic_hardness_Pa" in d:
+            extra = set(d) - {"rigid_plastic_hardness_Pa", "name"}
+            if extra:
+                raise ValueError(f"{where}: unknown key(s) {sorted(extra)} for a rigid-plastic material")
+            H = d["rigid_plastic_hardness_Pa"]
+            name = d.get("name", f"rigid_plastic_H{H / 1e6:g}MPa")
+            return rigid_plastic(name, H, coating=coating)
+        try:
+            return Material.from_dict(d)
+        except (TypeError, KeyError) as exc:
+            raise ValueError(f"{where}: not a material ({exc})") from None
+    raise ValueError(f"{where} = {spec!r} is not a material name, a rigid-plastic hardness or a material dict")
+
+
+# ----------------------------------------------------------------------------- the scene
+@dataclass(frozen=True)
+class Scene:
+    """Everything a ploughing run needs, in SI units."""
+
+    layers: Layers
+    load_N: float = 3.0
+    sphere: Sphere = field(default_factory=Sphere)
+    interface: Interface = field(default_factory=ProportionalShear)
+    domain: Domain = field(default_factory=Domain)
+    sliding: Sliding = field(default_factory=Sliding)
+    discretisation: Discretisation = field(default_factory=Discretisation)
+    outputs: Outputs = field(default_factory=Outputs)
+    name: str = "scene"
+
+    def __post_init__(self) -> None:
+        _finite_positive("scene", "load_N", self.load_N, "N")
+        if not isinstance(self.interface, ProportionalShear | ConstantShear | BoundaryLayerShear):
+            raise ValueError(f"interface = {self.interface!r} is not an interface model")
+        self._check_fits()
+
+    # -- feasibility: refuse what cannot work before running
+    def expected_contact(self) -> tuple[float, float]:
+        """(contact radius a, ploughing depth dp) from the analytical model, for sizing and checks.
+
+        Hardness of each layer: 3 sigma_y at a representative plastic strain of 0.08 (Tabor),
+        static rate, room temperature.
+        """
+        from plough.analytical import ploughing
+
+        Hs = representative_hardness(self.layers.substrate)
+        Hc = representative_hardness(self.layers.coating) if self.layers.coated else Hs
+        try:
+            res = ploughing(self.load_N, self.sphere.radius_m, self.layers.coating_thickness_m, Hc, Hs, k1=125.0)
+        except ValueError:
+            return self.sphere.radius_m, self.sphere.radius_m
+        return float(res.a), float(res.dp)
+
+    def _check_fits(self) -> None:
+        a, dp = self.expected_contact()
+        r, dom, h = self.sphere.radius_m, self.domain, self.discretisation.particle_size_m
+        if dp >= 0.5 * r:
+            raise ValueError(f"load_N = {self.load_N:g} N is too large for sphere.radius_m = {r:g} m: the "
+                             f"expected ploughing depth {dp:.3g} m exceeds half the radius")
+        # the plastic zone reaches ~2-3 contact radii; the fixed boundary must stay outside it
+        if 2.0 * a > dom.radius_m:
+            raise ValueError(f"domain.radius_m = {dom.radius_m:g} m is too small for the expected contact radius "
+                             f"{a:.3g} m (need domain.radius_m >= 2 a = {2 * a:.3g} m)")
+        if self.sliding.distance_m + 4.0 * a > dom.length_m:
+            raise ValueError(f"domain.length_m = {dom.length_m:g} m is too short for sliding.distance_m = "
+                             f"{self.sliding.distance_m:g} m plus 2 contact diameters ({4 * a:.3g} m)")
+        if h > 0.25 * dom.radius_m:
+            raise ValueError(f"discretisation.particle_size_m = {h:g} m is too coarse for domain.radius_m = "
+                             f"{dom.radius_m:g} m (allowed: h <= radius / 4)")
+        if self.sliding.control == "displacement" and self.sliding.depth_m >= 0.5 * r:
+            raise ValueError(f"sliding.depth_m = {self.sliding.depth_m:g} m must be below half the sphere radius")
+
+    # -- derived quantities
+    @property
+    def start_x_m(self) -> float:
+        """x of the sphere centre when pressing: the slide is centred in the block."""
+        return 0.5 * (self.domain.length_m - self.sliding.distance_m)
+
+    @property
+    def rate_scale(self) -> float:
+        """Physical over simulated strain rate, v_experiment / v_simulation."""
+        return self.sliding.experiment_speed_m_s / self.sliding.speed_m_s
+
+    # -- conversion
+    def to_dict(self) -> dict[str, Any]:
+        layers = {"coating_thickness_m": self.layers.coating_thickness_m,
+                  "substrate": self.layers.substrate.to_dict(),
+                  "coating": None if self.layers.coating is None else self.layers.coating.to_dict()}
+        outputs = asdict(self.outputs)
+        outputs["steady_window"] = list(self.outputs.steady_window)
+        return {
+            "name": self.name,
+            "load_N": self.load_N,
+            "sphere": asdict(self.sphere),
+            "layers": layers,
+            "interface": interface_to_dict(self.interface),
+            "domain": asdict(self.domain),
+            "sliding": asdict(self.sliding),
+            "discretisation": asdict(self.discretisation),
+            "outputs": outputs,
+        }
+
+    @classmethod
+    def from_dict(cls, d: dict[str, Any]) -> Scene:
+        d = dict(d)
+        allowed = {f.name for f in fields(cls)}
+        unknown = set(d) - allowed
+        if unknown:
+            raise ValueError(f"scene: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+        if "layers" not in d:
+            raise ValueError("scene: the key 'layers' (substrate, coating, coating_thickness) is required")
+        lay = _to_si(dict(d["layers"]))
+        unknown = set(lay) - {"substrate", "coating", "coating_thickness_m"}
+        if unknown:
+            raise ValueError(f"layers: unknown key(s) {sorted(unknown)}")
+        if "substrate" not in lay:
+            raise ValueError("layers.substrate is required")
+        t = float(lay.get("coating_thickness_m", 0.0) or 0.0)
+        coating_spec = lay.get("coating")
+        layers = Layers(
+            substrate=material_from_spec(lay["substrate"], coating=False, where="layers.substrate"),
+            coating=None if coating_spec is None else material_from_spec(coating_spec, coating=True,
+                                                                           where="layers.coating"),
+            coating_thickness_m=t,
+        )
+        kwargs: dict[str, Any] = {"layers": layers}
+        if "name" in d:
+            kwargs["name"] = str(d["name"])
+        if "load_N" in d:
+            kwargs["load_N"] = _coerce(d["load_N"], "float", "load_N")
+        if "interface" in d:
+            kwargs["interface"] = interface_from_dict(_to_si(dict(d["interface"])))
+        for key, cls_ in (("sphere", Sphere), ("domain", Domain), ("sliding", Sliding),
+                          ("discretisation", Discretisation), ("outputs", Outputs)):
+            if key in d:
+                part = dict(d[key] or {})
+                if key == "outputs" and "steady_window" in part:
+                    part["steady_window"] = tuple(float(x) for x in part["steady_window"])
+                kwargs[key] = _from_dict(cls_, part, key)
+        return cls(**kwargs)
+
+    def to_yaml(self, path: str | Path | None = None) -> str:
+        text = yaml.safe_dump(self.to_dict(), sort_keys=False)
+        if path is not None:
+            Path(path).write_text(text)
+        return text
+
+    @classmethod
+    def from_yaml(cls, path_or_text: str | Path) -> Scene:
+        p = Path(path_or_text)
+        if isinstance(path_or_text, Path) or (isinstance(path_or_text, str) and "\n" not in path_or_text):
+            if not p.exists():
+                raise FileNotFoundError(f"scene file {str(p)!r} does not exist")
+            text = p.read_text()
+        else:
+            text = str(path_or_text)
+        data = yaml.safe_load(text)
+        if not isinstance(data, dict):
+            raise ValueError("a scene file must hold a mapping of keys to values")
+        return cls.from_dict(data)
+
+    def with_(self, **changes: Any) -> Scene:
+        """A copy with some top-level parts replaced (validated again)."""
+        return replace(self, **changes)

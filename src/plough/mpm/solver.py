@@ -1,0 +1,273 @@
+"""Explicit MPM ploughing solver: initialise a state from a scene, advance it step by step.
+
+One step (model.md section 2):
+
+1. P2G: particle mass, momentum and stress divergence to the grid (APIC/MLS).
+2. Grid update: nodal velocities with the internal force; fixed curved surface, mirror plane.
+3. Contact: the rigid sphere on the nodes inside it, traction-limited interface shear (eq. 8);
+   the reaction is the force on the sphere.
+4. Sphere motion: pressing, then sliding along x; its height floats under load control.
+5. G2P: velocities and velocity gradients back to the particles, stress update (eqs. 6.1-6.2,
+   7.1-7.3), advection, instability checks.
+
+The time step is dt = CFL dx / c with c = sqrt((K + 4G/3) / (ms rho)) the mass-scaled elastic
+wave speed.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numba
+import numpy as np
+
+from plough.materials import (
+    BoundaryLayerShear,
+    ConstantShear,
+    ProportionalShear,
+)
+from plough.mpm import contact, transfers
+from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
+from plough.mpm.grid import Grid, boundary_flags, make_grid
+from plough.mpm.particles import Particles, seed_particles
+from plough.mpm.scene import Scene
+
+# Load controller (see control_load): force filter time and loop gain, in steps and multiples
+# of the expected plastic contact stiffness Fn / dp. Chosen on the reference scene so that the
+# sphere settles within ~2 contact radii of sliding without oscillating (README, issue 3 note).
+FILTER_STEPS = 10.0
+CONTROL_STEPS = 40.0
+STIFFNESS_FACTOR = 2.0
+SETTLE_STEPS = 300
+
+
+class SimulationError(RuntimeError):
+    """A run went unstable; the message names the step, the sliding distance and the likely cause."""
+
+
+@dataclass
+class SphereState:
+    centre: np.ndarray  # (3,) m
+    velocity: np.ndarray  # (3,) m/s
+    fz_filtered: float = 0.0
+    phase: str = "press"  # press -> settle -> slide -> done
+    settle_left: int = SETTLE_STEPS
+    slid_m: float = 0.0
+
+
+@dataclass
+class Constants:
+    """Everything a step needs that does not change during a run."""
+
+    dt: float
+    grid: Grid
+    table: np.ndarray
+    rate_scale: float
+    taylor_quinney: float
+    interface_model: int
+    interface_params: np.ndarray
+    near_dist: float
+    grid_lo: np.ndarray
+    grid_hi: np.ndarray
+    load_N: float
+    press_speed: float
+    slide_speed: float
+    slide_distance: float
+    control_gain: float  # m/s per N
+    filter_alpha: float
+    control: str
+    target_depth: float | None
+    sphere_radius: float
+    steps_slide: int
+    shape: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.int64))
+
+
+@dataclass
+class Work:
+    """Per-step scratch and the running energy account (J)."""
+
+    grid_buf: np.ndarray
+    grid_m: np.ndarray
+    grid_v: np.ndarray
+    flags: np.ndarray
+    cbuf: np.ndarray
+    acc: np.ndarray
+    contact_out: np.ndarray
+    external_work: float = 0.0
+    plastic_work: float = 0.0
+    interface_dissipation: float = 0.0
+    contact_impact_loss: float = 0.0
+    heat: float = 0.0
+
+
+@dataclass
+class State:
+    particles: Particles
+    sphere: SphereState
+    work: Work
+    step: int = 0
+    time: float = 0.0
+
+
+# ----------------------------------------------------------------------------- set-up
+def wave_speed(table: np.ndarray, mass_scaling: float) -> float:
+    """Largest mass-scaled P-wave speed sqrt((K + 4G/3) / (ms rho)) over the materials."""
+    return float(np.max(np.sqrt((table[:, I_K] + 4.0 / 3.0 * table[:, I_G]) / (mass_scaling * table[:, I_RHO]))))
+
+
+def interface_arrays(scene: Scene) -> tuple[int, np.ndarray]:
+    itf = scene.interface
+    if isinstance(itf, ProportionalShear):
+        return contact.INTERFACE_PROPORTIONAL, np.array([itf.f, 0.0])
+    if isinstance(itf, ConstantShear):
+        return contact.INTERFACE_CONSTANT, np.array([itf.tau_Pa, 0.0])
+    if isinstance(itf, BoundaryLayerShear):
+        return contact.INTERFACE_BOUNDARY_LAYER, np.array([itf.Cp, itf.np])
+    raise ValueError(f"interface = {itf!r} is unknown")
+
+
+def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
+    """The initial state (undeformed block, sphere touching the surface) and the run constants."""
+    mats = scene.layers.materials
+    table = pack_materials(mats)
+    rows = {"substrate": len(mats) - 1}
+    if scene.layers.coated:
+        rows["coating"] = 0
+    particles = seed_particles(scene, rows, table[:, I_RHO])
+
+    disc = scene.discretisation
+    dx = disc.cell_size_m
+    a_exp, dp_exp = scene.expected_contact()
+    headroom = max(2.0 * dp_exp, 2.0 * dx) + 0.5 * dp_exp
+    grid = make_grid(scene.domain.length_m, scene.domain.radius_m, scene.domain.symmetric, dx, headroom)
+    c = wave_speed(table, disc.mass_scaling)
+    v_max = scene.sliding.speed_m_s * 2.0
+    dt = disc.cfl * dx / (c + v_max)
+
+    model, iparams = interface_arrays(scene)
+    r = scene.sphere.radius_m
+    n_chunks = n_chunks or max(numba.get_num_threads(), 1)
+    centre = np.array([scene.start_x_m, 0.0, r])
+    k_est = STIFFNESS_FACTOR * scene.load_N / max(dp_exp, 0.25 * scene.discretisation.particle_size_m)
+    const = Constants(
+        dt=dt, grid=grid, table=table, rate_scale=scene.rate_scale, taylor_quinney=scene.outputs.taylor_quinney,
+        interface_model=model, interface_params=iparams, near_dist=3.0 * dx,
+        grid_lo=grid.origin + 1.0 * dx, grid_hi=grid.upper - 1.0 * dx, load_N=scene.load_N,
+        press_speed=scene.sliding.press_speed_fraction * scene.sliding.speed_m_s,
+        slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
+        control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
+        control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
+        steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
+        shape=np.array(grid.shape, dtype=np.int64),
+    )
+    work = Work(
+        grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
+        grid_v=np.zeros((grid.n_nodes, 3)), flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
+        cbuf=np.zeros((grid.n_nodes, 8)), acc=np.zeros((n_chunks, transfers.N_ACC)),
+        contact_out=np.zeros(contact.N_OUT),
+    )
+    sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
+    return State(particles=particles, sphere=sphere, work=work), const
+
+
+# ----------------------------------------------------------------------------- one step
+def step(s: State, c: Constants) -> None:
+    """Advance the state by one time step dt."""
+    p, w, sph = s.particles, s.work, s.sphere
+    g = c.grid
+    transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf)
+    transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v)
+    contact.scatter_contact_stress(p.x, p.stress, p.mass, p.eps_p, p.temperature, p.mat_a, p.mat_b, p.frac_a,
+                                   c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius, w.cbuf)
+    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
+                           sph.velocity, c.dt, c.interface_model, c.interface_params, w.contact_out)
+    move_sphere(sph, c)
+    transfers.g2p(w.grid_v, g.origin, g.dx, c.dt, c.shape, p.x, p.v, p.C, p.stress, p.J, p.vol0, p.mass, p.eps_p,
+                  p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney, sph.centre,
+                  c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi)
+    account_energy(w)
+    check_stability(s, c)
+    control_sphere(sph, reaction_z(w), c)
+    s.step += 1
+    s.time += c.dt
+
+
+def reaction_z(w: Work) -> float:
+    """Upward force of the material on the sphere (normal-traction plus interface-shear parts)."""
+    out = w.contact_out
+    return float(out[contact.OUT_FN + 2] + out[contact.OUT_FT + 2])
+
+
+def move_sphere(sph: SphereState, c: Constants) -> None:
+    sph.centre += c.dt * sph.velocity
+    if sph.phase == "slide":
+        sph.slid_m += c.dt * sph.velocity[0]
+
+
+def account_energy(w: Work) -> None:
+    out = w.contact_out
+    # sphere power x dt = work on the material + interface slip loss + inelastic normal impact loss
+    w.external_work += float(out[contact.OUT_WORK])
+    w.interface_dissipation += float(out[contact.OUT_DISSIPATION])
+    w.contact_impact_loss += float(out[contact.OUT_IMPACT])
+    w.plastic_work += float(w.acc[:, transfers.ACC_PLASTIC_WORK].sum())
+    w.heat += float(w.acc[:, transfers.ACC_HEAT].sum())
+
+
+def control_sphere(sph: SphereState, fz: float, c: Constants) -> None:
+    """Press, settle, slide; under load control the height follows the filtered reaction.
+
+    The vertical speed is proportional to the load error, v_z = -gain (Fn - Fz_filtered),
+    bounded by the pressing speed: a first-order approach without overshoot whose time constant
+    is CONTROL_STEPS x (expected stiffness / actual stiffness) steps.
+    """
+    sph.fz_filtered += c.filter_alpha * (fz - sph.fz_filtered)
+    if c.control == "load":
+        vz = -c.control_gain * (c.load_N - sph.fz_filtered)
+        vz = min(max(vz, -c.press_speed), c.press_speed)
+        reached = sph.fz_filtered >= c.load_N
+    else:
+        depth = c.sphere_radius - sph.centre[2]
+        vz = -c.press_speed if depth < c.target_depth else 0.0
+        vz = max(vz, -(c.target_depth - depth) / c.dt)
+        reached = depth >= c.target_depth * (1 - 1e-9)
+    if sph.phase == "press":
+        sph.velocity[2] = -c.press_speed if not reached else vz
+        if reached:
+            sph.phase = "settle"
+    else:
+        sph.velocity[2] = vz
+    if sph.phase == "settle":
+        sph.settle_left -= 1
+        if sph.settle_left <= 0:
+            sph.phase = "slide"
+            sph.velocity[0] = c.slide_speed
+    if sph.phase == "slide" and sph.slid_m >= c.slide_distance:
+        sph.phase = "done"
+        sph.velocity[:] = 0.0
+
+
+CAUSES = {
+    transfers.BAD_NONFINITE: "non-finite velocity or stress: the time step is too large (lower discretisation.cfl) "
+                             "or the mass scaling too small",
+    transfers.BAD_J: "a particle's volume collapsed or exploded (J <= 0 or J > 4): time step too large (cfl) or "
+                     "the sphere tears the material (load too high for the particle size)",
+    transfers.BAD_LEFT_GRID: "a particle left the grid: the load is too high for the domain (enlarge domain.radius_m"
+                             " / length_m) or the material was flung out by inertia (lower mass_scaling or speed)",
+}
+
+
+def check_stability(s: State, c: Constants) -> None:
+    """Stop at once, naming the step, the sliding distance and the likely cause."""
+    acc = s.work.acc
+    bad = int(acc[:, transfers.ACC_BAD].max())
+    where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
+    if bad != transfers.BAD_NONE:
+        raise SimulationError(f"unstable run {where}: {CAUSES[bad]}")
+    kinetic = float(acc[:, transfers.ACC_KINETIC].sum())
+    budget = 2.0 * abs(s.work.external_work) + c.load_N * c.grid.dx
+    if kinetic > budget:
+        raise SimulationError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
+                              f"by the sphere ({s.work.external_work:.3g} J): inertia dominates; lower "
+                              "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")

@@ -1,0 +1,270 @@
+"""Particle-grid transfers of explicit MLS-MPM / APIC (model.md section 2).
+
+One step moves momentum particle -> grid (P2G), updates the grid velocity with the internal
+force, applies boundary conditions and contact, and moves velocity grid -> particle (G2P), where
+the velocity gradient drives the stress update (eq. 6.1) and the particles are advected.
+
+- P2G (APIC with the MLS internal force, Hu et al. 2018):
+      m_i  = sum_p w_ip m_p
+      (mv)_i = sum_p w_ip [m_p v_p + (m_p C_p - dt V_p D^-1 sigma_p)(x_i - x_p)],  D^-1 = 4/dx^2
+- G2P: v_p = sum_i w_ip v_i,  C_p = D^-1 sum_i w_ip v_i (x_i - x_p)^T  (= velocity gradient L_p),
+      J_p <- J_p det(I + dt L_p),  x_p <- x_p + dt v_p.
+
+Threads: particles are cut into ``n_chunks`` contiguous chunks (in seeding order, so a chunk is a
+slab of the block). The scatter is race-free by construction: chunk c writes only its own grid
+copy ``grid_buf[c]``; the grid update sums the copies node by node (each node owned by one
+iteration). The gather reads the grid and writes only particle p's own entries.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit, prange
+
+from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
+from plough.mpm.grid import FIXED, MIRROR
+from plough.mpm.shape import APIC_D_INV_FACTOR, bspline2
+
+# per-chunk accumulators written by g2p
+ACC_PLASTIC_WORK = 0
+ACC_KINETIC = 1
+ACC_ELASTIC = 2
+ACC_PENETRATION = 3
+ACC_BAD = 4
+ACC_BAD_INDEX = 5
+ACC_HEAT = 6
+N_ACC = 7
+# codes of ACC_BAD, worst last
+BAD_NONE, BAD_LEFT_GRID, BAD_J, BAD_NONFINITE = 0, 1, 2, 3
+
+
+@njit(cache=True, parallel=True)
+def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf):
+    """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
+
+    Reads x, v, C, stress, vol0, J, mass (particles). Writes grid_buf[c, node, 0:4] = (mass,
+    momentum x, y, z) of chunk c, zeroing it first. Race-free: chunk c owns grid_buf[c].
+    """
+    n = x.shape[0]
+    n_chunks = grid_buf.shape[0]
+    ny, nz = shape[1], shape[2]
+    inv_dx = 1.0 / dx
+    dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
+    for c in prange(n_chunks):
+        buf = grid_buf[c]
+        buf[:, :] = 0.0
+        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
+            m = mass[p]
+            k_stress = -dt * vol0[p] * J[p] * dinv
+            s = stress[p]
+            # affine momentum matrix Q = m C - dt V D^-1 sigma
+            q00 = m * C[p, 0, 0] + k_stress * s[0]
+            q11 = m * C[p, 1, 1] + k_stress * s[1]
+            q22 = m * C[p, 2, 2] + k_stress * s[2]
+            q12 = m * C[p, 1, 2] + k_stress * s[3]
+            q21 = m * C[p, 2, 1] + k_stress * s[3]
+            q02 = m * C[p, 0, 2] + k_stress * s[4]
+            q20 = m * C[p, 2, 0] + k_stress * s[4]
+            q01 = m * C[p, 0, 1] + k_stress * s[5]
+            q10 = m * C[p, 1, 0] + k_stress * s[5]
+            mv0, mv1, mv2 = m * v[p, 0], m * v[p, 1], m * v[p, 2]
+            gx = (x[p, 0] - origin[0]) * inv_dx
+            gy = (x[p, 1] - origin[1]) * inv_dx
+            gz = (x[p, 2] - origin[2]) * inv_dx
+            bx, wx0, wx1, wx2 = bspline2(gx)
+            by, wy0, wy1, wy2 = bspline2(gy)
+            bz, wz0, wz1, wz2 = bspline2(gz)
+            for a in range(3):
+                wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
+                d0 = (bx + a - gx) * dx
+                for b in range(3):
+                    wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
+                    d1 = (by + b - gy) * dx
+                    row = ((bx + a) * ny + (by + b)) * nz + bz
+                    for cc in range(3):
+                        w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
+                        d2 = (bz + cc - gz) * dx
+                        node = row + cc
+                        buf[node, 0] += w * m
+                        buf[node, 1] += w * (mv0 + q00 * d0 + q01 * d1 + q02 * d2)
+                        buf[node, 2] += w * (mv1 + q10 * d0 + q11 * d1 + q12 * d2)
+                        buf[node, 3] += w * (mv2 + q20 * d0 + q21 * d1 + q22 * d2)
+
+
+@njit(cache=True, parallel=True)
+def grid_update(grid_buf, flags, grid_m, grid_v):
+    """Sum the chunk copies into nodal mass and velocity and apply the boundary conditions.
+
+    Reads grid_buf (P2G output) and flags (FREE / FIXED / MIRROR). Writes grid_m[node] and
+    grid_v[node, 0:3] (velocity at the end of the step before contact). Each node is owned by
+    one iteration, so the reduction is race-free.
+    """
+    n_chunks = grid_buf.shape[0]
+    for node in prange(grid_m.shape[0]):
+        m = 0.0
+        p0 = 0.0
+        p1 = 0.0
+        p2 = 0.0
+        for c in range(n_chunks):
+            m += grid_buf[c, node, 0]
+            p0 += grid_buf[c, node, 1]
+            p1 += grid_buf[c, node, 2]
+            p2 += grid_buf[c, node, 3]
+        grid_m[node] = m
+        if m <= 0.0 or flags[node] == FIXED:
+            grid_v[node, 0] = 0.0
+            grid_v[node, 1] = 0.0
+            grid_v[node, 2] = 0.0
+            continue
+        grid_v[node, 0] = p0 / m
+        grid_v[node, 1] = 0.0 if flags[node] == MIRROR else p1 / m
+        grid_v[node, 2] = p2 / m
+
+
+@njit(cache=True, parallel=True)
+def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat_a, mat_b,
+        frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo, grid_hi):
+    """Gather velocities, update stress (eq. 6.1-6.2), advect, and check the particle state.
+
+    Reads grid_v, the sphere (centre sphere_c after this step, radius sphere_r). Writes particle
+    v, C, J, x, stress, eps_p, temperature, near (1 if within near_dist of the sphere surface),
+    and per-chunk accumulators acc[c, :] (plastic work, kinetic and elastic energy, adiabatic
+    heat, deepest penetration of a particle centre into the sphere, worst instability code and
+    the particle showing it). Each particle writes only its own entries.
+    """
+    n = x.shape[0]
+    n_chunks = acc.shape[0]
+    ny, nz = shape[1], shape[2]
+    inv_dx = 1.0 / dx
+    dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
+    for c in prange(n_chunks):
+        wp_sum = 0.0
+        ke_sum = 0.0
+        el_sum = 0.0
+        heat_sum = 0.0
+        pen_max = -1e300
+        bad = BAD_NONE
+        bad_p = -1
+        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
+            gx = (x[p, 0] - origin[0]) * inv_dx
+            gy = (x[p, 1] - origin[1]) * inv_dx
+            gz = (x[p, 2] - origin[2]) * inv_dx
+            bx, wx0, wx1, wx2 = bspline2(gx)
+            by, wy0, wy1, wy2 = bspline2(gy)
+            bz, wz0, wz1, wz2 = bspline2(gz)
+            v0 = 0.0
+            v1 = 0.0
+            v2 = 0.0
+            b00 = 0.0
+            b01 = 0.0
+            b02 = 0.0
+            b10 = 0.0
+            b11 = 0.0
+            b12 = 0.0
+            b20 = 0.0
+            b21 = 0.0
+            b22 = 0.0
+            for a in range(3):
+                wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
+                d0 = (bx + a - gx) * dx
+                for b in range(3):
+                    wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
+                    d1 = (by + b - gy) * dx
+                    row = ((bx + a) * ny + (by + b)) * nz + bz
+                    for cc in range(3):
+                        w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
+                        d2 = (bz + cc - gz) * dx
+                        node = row + cc
+                        gv0 = w * grid_v[node, 0]
+                        gv1 = w * grid_v[node, 1]
+                        gv2 = w * grid_v[node, 2]
+                        v0 += gv0
+                        v1 += gv1
+                        v2 += gv2
+                        b00 += gv0 * d0
+                        b01 += gv0 * d1
+                        b02 += gv0 * d2
+                        b10 += gv1 * d0
+                        b11 += gv1 * d1
+                        b12 += gv1 * d2
+                        b20 += gv2 * d0
+                        b21 += gv2 * d1
+                        b22 += gv2 * d2
+            v[p, 0] = v0
+            v[p, 1] = v1
+            v[p, 2] = v2
+            Cp = C[p]
+            Cp[0, 0] = dinv * b00
+            Cp[0, 1] = dinv * b01
+            Cp[0, 2] = dinv * b02
+            Cp[1, 0] = dinv * b10
+            Cp[1, 1] = dinv * b11
+            Cp[1, 2] = dinv * b12
+            Cp[2, 0] = dinv * b20
+            Cp[2, 1] = dinv * b21
+            Cp[2, 2] = dinv * b22
+            J_new = J[p] * _det_i_plus(dt, Cp)
+            J[p] = J_new
+            pa = table[mat_a[p]]
+            pb = table[mat_b[p]]
+            deps, w_pl = update_stress(stress, p, Cp, dt, J_new, eps_p, temperature, pa, pb, frac_a[p],
+                                       rate_scale, taylor_quinney)
+            vol = vol0[p] * J_new
+            wp_sum += w_pl * vol
+            heat_sum += taylor_quinney * w_pl * vol
+            K, G = mixed_moduli(pa, pb, frac_a[p])
+            el_sum += elastic_energy_density(stress, p, K, G) * vol
+            ke_sum += 0.5 * mass[p] * (v0 * v0 + v1 * v1 + v2 * v2)
+            x0 = x[p, 0] + dt * v0
+            x1 = x[p, 1] + dt * v1
+            x2 = x[p, 2] + dt * v2
+            x[p, 0] = x0
+            x[p, 1] = x1
+            x[p, 2] = x2
+            r0 = x0 - sphere_c[0]
+            r1 = x1 - sphere_c[1]
+            r2 = x2 - sphere_c[2]
+            dist = math.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
+            near[p] = 1 if dist < sphere_r + near_dist else 0
+            if sphere_r - dist > pen_max:
+                pen_max = sphere_r - dist
+            # instability checks, worst code kept
+            code = BAD_NONE
+            if not (math.isfinite(x0 + x1 + x2) and math.isfinite(stress[p, 0] + stress[p, 1] + stress[p, 2])):
+                code = BAD_NONFINITE
+            elif J_new <= 0.0 or J_new > 4.0:
+                code = BAD_J
+            elif (x0 < grid_lo[0] or x1 < grid_lo[1] or x2 < grid_lo[2] or x0 > grid_hi[0] or x1 > grid_hi[1]
+                  or x2 > grid_hi[2]):
+                code = BAD_LEFT_GRID
+            if code > bad:
+                bad = code
+                bad_p = p
+        acc[c, ACC_PLASTIC_WORK] = wp_sum
+        acc[c, ACC_KINETIC] = ke_sum
+        acc[c, ACC_ELASTIC] = el_sum
+        acc[c, ACC_HEAT] = heat_sum
+        acc[c, ACC_PENETRATION] = pen_max
+        acc[c, ACC_BAD] = bad
+        acc[c, ACC_BAD_INDEX] = bad_p
+
+
+@njit(cache=True, inline="always")
+def _det_i_plus(dt, L):
+    """det(I + dt L): the volume ratio of one step."""
+    a00 = 1.0 + dt * L[0, 0]
+    a01 = dt * L[0, 1]
+    a02 = dt * L[0, 2]
+    a10 = dt * L[1, 0]
+    a11 = 1.0 + dt * L[1, 1]
+    a12 = dt * L[1, 2]
+    a20 = dt * L[2, 0]
+    a21 = dt * L[2, 1]
+    a22 = 1.0 + dt * L[2, 2]
+    return a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) + a02 * (a10 * a21 - a11 * a20)
+
+
+def allocate_grid_buffers(n_chunks: int, n_nodes: int) -> np.ndarray:
+    return np.zeros((n_chunks, n_nodes, 4))
