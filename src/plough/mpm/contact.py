@@ -1,7 +1,13 @@
 """Contact of the material with the rigid analytic sphere, on the grid (model.md section 2, eq. 8).
 
-A node inside the sphere whose velocity approaches the sphere gets the sphere's normal velocity
-(impenetrability). The tangential velocity change is a traction-limited impulse:
+A node near the sphere (inside it or within one cell of its surface) that carries a particle
+touching the sphere, and whose velocity approaches the sphere along the outward normal n from
+the centre, gets the sphere's normal velocity (impenetrability). Requiring a touching particle keeps nodes that lie inside the sphere but
+above the free surface (they carry a little mass from the top particles through the B-spline
+stencil) from acting as contact too early, which otherwise holds the material about one cell
+away from the sphere.
+
+The tangential velocity change is a traction-limited impulse:
 
     J_t <= tau * A_i * dt,     A_i = min(F_n,i / P_i, dx^2)
 
@@ -38,6 +44,8 @@ OUT_WORK = 8  # work done by the sphere on the material this step, J
 OUT_NODES = 9  # number of contact nodes
 OUT_AREA_XY = 10  # contact area projected on the xy plane, m^2
 N_OUT = 11
+#: channels of the contact scratch: 6 stress, kappa, mass weight, touching flag
+N_CBUF = 9
 
 
 @njit(cache=True)
@@ -52,21 +60,27 @@ def _inside_box(origin, dx, shape, centre, radius):
 
 
 @njit(cache=True)
-def scatter_contact_stress(x, stress, mass, eps_p, temperature, mat_a, mat_b, frac_a, table, near, origin, dx,
-                           shape, centre, radius, cbuf):
-    """Mass-weighted stress and shear strength of the particles near the sphere onto its inner nodes.
+def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near, origin,
+                           dx, shape, centre, radius, cbuf):
+    """Mass-weighted stress and shear strength of the particles near the sphere onto nearby nodes.
 
-    Reads particle x, stress, mass, eps_p, temperature, materials and ``near`` (set by g2p).
-    Writes cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m for
-    nodes inside the sphere. Serial: few particles touch the sphere. ``sphere_contact`` consumes
-    and re-zeroes these entries.
+    Reads particle x, stress, mass, vol0, J, eps_p, temperature, materials and ``near`` (set by
+    g2p). For nodes within one cell of the sphere surface (or inside it) writes
+    cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m and sets
+    cbuf[node, 8] = 1 if one of its particles touches the sphere (the particle's face, half a
+    particle size from its centre, reaches the sphere surface). Serial: few particles are near
+    the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
     """
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
-    r2 = radius * radius
+    reach2 = (radius + dx) * (radius + dx)
     for p in range(x.shape[0]):
         if near[p] == 0:
             continue
+        q0 = x[p, 0] - centre[0]
+        q1 = x[p, 1] - centre[1]
+        q2 = x[p, 2] - centre[2]
+        touching = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2) - radius <= 0.5 * (vol0[p] * J[p]) ** (1.0 / 3.0)
         kappa = mixed_flow_stress(table[mat_a[p]], table[mat_b[p]], frac_a[p], eps_p[p], 0.0,
                                   temperature[p]) / SQRT3
         gx = (x[p, 0] - origin[0]) * inv_dx
@@ -83,7 +97,7 @@ def scatter_contact_stress(x, stress, mass, eps_p, temperature, mat_a, mat_b, fr
                 py = origin[1] + (by + b) * dx - centre[1]
                 for cc in range(3):
                     pz = origin[2] + (bz + cc) * dx - centre[2]
-                    if px * px + py * py + pz * pz >= r2:
+                    if px * px + py * py + pz * pz >= reach2:
                         continue
                     wm = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2)) * mass[p]
                     node = ((bx + a) * ny + (by + b)) * nz + bz + cc
@@ -91,6 +105,8 @@ def scatter_contact_stress(x, stress, mass, eps_p, temperature, mat_a, mat_b, fr
                         cbuf[node, k] += wm * stress[p, k]
                     cbuf[node, 6] += wm * kappa
                     cbuf[node, 7] += wm
+                    if touching:
+                        cbuf[node, 8] = 1.0
 
 
 @njit(cache=True)
@@ -115,8 +131,8 @@ def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sp
     ny, nz = shape[1], shape[2]
     for k in range(N_OUT):
         out[k] = 0.0
-    i0, i1, j0, j1, k0, k1 = _inside_box(origin, dx, shape, centre, radius)
-    r2 = radius * radius
+    i0, i1, j0, j1, k0, k1 = _inside_box(origin, dx, shape, centre, radius + dx)
+    r2 = (radius + dx) * (radius + dx)
     dx2 = dx * dx
     for i in range(i0, i1 + 1):
         px = origin[0] + i * dx - centre[0]
@@ -136,10 +152,11 @@ def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sp
                 s4 = cbuf[node, 4]
                 s5 = cbuf[node, 5]
                 kap = cbuf[node, 6]
-                for k in range(8):
+                touching = cbuf[node, 8] > 0.0
+                for k in range(N_CBUF):
                     cbuf[node, k] = 0.0
                 m = grid_m[node]
-                if m <= 0.0:
+                if m <= 0.0 or not touching:
                     continue
                 dist = math.sqrt(d2)
                 if dist <= 0.0:

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import base64
 import json
-import time
 from pathlib import Path
 
 import numpy as np
@@ -25,7 +24,7 @@ from plough.mpm.scene import Scene
 
 SERIES_META = {
     "Fx": ("N", "friction force on the sphere (resisting the sliding, positive)"),
-    "Fy": ("N", "lateral force on the sphere"),
+    "Fy": ("N", "lateral force on the sphere (0 by symmetry with the mirror plane)"),
     "Fz": ("N", "normal force on the sphere (upward reaction, positive)"),
     "Fx_pl": ("N", "friction force from normal traction (ploughing part)"),
     "Fx_sh": ("N", "friction force from interface shear (shear part)"),
@@ -123,6 +122,8 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     for name, value in steady.items():
         u, ln = STEADY_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
+    ds.attrs["forces_and_energies"] = ("full body (twice the simulated half with the mirror plane)"
+                                       if scene.domain.symmetric else "full body")
     for name, value in cost.items():
         ds.attrs[f"cost_{name}"] = value
     ds.attrs.update(provenance_attrs(scene.to_dict(), key="scene"))
@@ -195,7 +196,7 @@ def write_snapshot(p: Particles, path: str | Path, sphere_centre: np.ndarray, sp
         "</Verts>",
         "</Piece>",
         "</PolyData>",
-        f"<!-- sphere centre {sphere_centre.tolist()} m, radius {sphere_radius} m, written {time.strftime('%F %T')} -->",
+        f"<!-- sphere centre {sphere_centre.tolist()} m, radius {sphere_radius} m -->",
         "</VTKFile>",
     ]
     path.write_text("\n".join(xml))

@@ -30,8 +30,11 @@ class _Recorder:
 
     def add(self, s: solver.State, c: solver.Constants) -> None:
         out = s.work.contact_out
-        fn, ft = out[contact.OUT_FN:contact.OUT_FN + 3], out[contact.OUT_FT:contact.OUT_FT + 3]
-        self._sum += np.array([-(fn[0] + ft[0]), fn[1] + ft[1], fn[2] + ft[2], -fn[0], -ft[0], fn[2], ft[2]])
+        # full-body forces: the mirror half carries half of Fx and Fz, and Fy of the full body is 0
+        k = c.symmetry_factor
+        fn, ft = k * out[contact.OUT_FN:contact.OUT_FN + 3], k * out[contact.OUT_FT:contact.OUT_FT + 3]
+        fy = 0.0 if k == 2.0 else fn[1] + ft[1]
+        self._sum += np.array([-(fn[0] + ft[0]), fy, fn[2] + ft[2], -fn[0], -ft[0], fn[2], ft[2]])
         self._count += 1
         pen = float(s.work.acc[:, transfers.ACC_PENETRATION].max())
         self.max_penetration = max(self.max_penetration, pen)
@@ -42,16 +45,16 @@ class _Recorder:
         if self._count == 0:
             return
         m = self._sum / self._count
-        acc, w = s.work.acc, s.work
+        acc, w, k = s.work.acc, s.work, c.symmetry_factor
         self.rows.append({
             "Fx": m[0], "Fy": m[1], "Fz": m[2], "Fx_pl": m[3], "Fx_sh": m[4], "Fz_pl": m[5], "Fz_sh": m[6],
             "depth": c.sphere_radius - s.sphere.centre[2],
-            "particle_penetration": pen, "contact_area_xy": float(w.contact_out[contact.OUT_AREA_XY]),
-            "external_work": w.external_work, "plastic_work": w.plastic_work,
-            "elastic_energy": float(acc[:, transfers.ACC_ELASTIC].sum()),
-            "kinetic_energy": float(acc[:, transfers.ACC_KINETIC].sum()),
-            "interface_dissipation": w.interface_dissipation, "contact_impact_loss": w.contact_impact_loss,
-            "heat": w.heat, "time": s.time,
+            "particle_penetration": pen, "contact_area_xy": k * float(w.contact_out[contact.OUT_AREA_XY]),
+            "external_work": k * w.external_work, "plastic_work": k * w.plastic_work,
+            "elastic_energy": k * float(acc[:, transfers.ACC_ELASTIC].sum()),
+            "kinetic_energy": k * float(acc[:, transfers.ACC_KINETIC].sum()),
+            "interface_dissipation": k * w.interface_dissipation, "contact_impact_loss": k * w.contact_impact_loss,
+            "heat": k * w.heat, "time": s.time,
         })
         self.slid.append(s.sphere.slid_m if s.sphere.phase in ("slide", "done") else 0.0)
         self._sum[:] = 0.0
@@ -85,8 +88,9 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                     f"the sphere did not reach the load in {state.step} steps: load_N = {scene.load_N:g} N may be "
                     "too high for the domain, or the contact is lost")
             if snapshots_dir is not None and state.sphere.slid_m >= next_snap and state.sphere.phase == "slide":
-                io.write_snapshot(state.particles, Path(snapshots_dir) / f"{scene.name}_{int(round(next_snap * 1e6)):05d}um.vtp",
-                                  state.sphere.centre, const.sphere_radius, coating_row)
+                name = f"{scene.name}_{int(round(next_snap * 1e6)):05d}um.vtp"
+                io.write_snapshot(state.particles, Path(snapshots_dir) / name, state.sphere.centre,
+                                  const.sphere_radius, coating_row)
                 next_snap += snap_every
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)

@@ -27,9 +27,9 @@ from plough.materials import (
     Material,
     ProportionalShear,
     get_material,
-    representative_hardness,
     interface_from_dict,
     interface_to_dict,
+    representative_hardness,
     rigid_plastic,
 )
 

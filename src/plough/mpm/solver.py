@@ -71,6 +71,7 @@ class Constants:
     grid_lo: np.ndarray
     grid_hi: np.ndarray
     load_N: float
+    symmetry_factor: float  # 2 with the mirror plane: the simulated half carries load_N / 2
     press_speed: float
     slide_speed: float
     slide_distance: float
@@ -150,10 +151,13 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     n_chunks = n_chunks or max(numba.get_num_threads(), 1)
     centre = np.array([scene.start_x_m, 0.0, r])
     k_est = STIFFNESS_FACTOR * scene.load_N / max(dp_exp, 0.25 * scene.discretisation.particle_size_m)
+    if scene.domain.symmetric:
+        k_est *= 0.5  # the simulated half carries half the load at the same depth
     const = Constants(
         dt=dt, grid=grid, table=table, rate_scale=scene.rate_scale, taylor_quinney=scene.outputs.taylor_quinney,
         interface_model=model, interface_params=iparams, near_dist=3.0 * dx,
         grid_lo=grid.origin + 1.0 * dx, grid_hi=grid.upper - 1.0 * dx, load_N=scene.load_N,
+        symmetry_factor=2.0 if scene.domain.symmetric else 1.0,
         press_speed=scene.sliding.press_speed_fraction * scene.sliding.speed_m_s,
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
@@ -163,8 +167,9 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
-        grid_v=np.zeros((grid.n_nodes, 3)), flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
-        cbuf=np.zeros((grid.n_nodes, 8)), acc=np.zeros((n_chunks, transfers.N_ACC)),
+        grid_v=np.zeros((grid.n_nodes, 3)),
+        flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
+        cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), acc=np.zeros((n_chunks, transfers.N_ACC)),
         contact_out=np.zeros(contact.N_OUT),
     )
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
@@ -178,8 +183,8 @@ def step(s: State, c: Constants) -> None:
     g = c.grid
     transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf)
     transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v)
-    contact.scatter_contact_stress(p.x, p.stress, p.mass, p.eps_p, p.temperature, p.mat_a, p.mat_b, p.frac_a,
-                                   c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius, w.cbuf)
+    contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
+                                   p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius, w.cbuf)
     contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
                            sph.velocity, c.dt, c.interface_model, c.interface_params, w.contact_out)
     move_sphere(sph, c)
@@ -188,13 +193,16 @@ def step(s: State, c: Constants) -> None:
                   c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi)
     account_energy(w)
     check_stability(s, c)
-    control_sphere(sph, reaction_z(w), c)
+    control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
     s.step += 1
     s.time += c.dt
 
 
 def reaction_z(w: Work) -> float:
-    """Upward force of the material on the sphere (normal-traction plus interface-shear parts)."""
+    """Upward force of the simulated material on the sphere (normal traction plus interface shear).
+
+    With the mirror plane this is the force of one half; the full-body force is twice it.
+    """
     out = w.contact_out
     return float(out[contact.OUT_FN + 2] + out[contact.OUT_FT + 2])
 
