@@ -2,10 +2,10 @@
 
 A node near the sphere (inside it or within one cell of its surface) that carries a particle
 touching the sphere, and whose velocity approaches the sphere along the outward normal n from
-the centre, gets the sphere's normal velocity (impenetrability). Requiring a touching particle keeps nodes that lie inside the sphere but
-above the free surface (they carry a little mass from the top particles through the B-spline
-stencil) from acting as contact too early, which otherwise holds the material about one cell
-away from the sphere.
+the centre, gets the sphere's normal velocity (impenetrability). Requiring a touching
+particle keeps nodes that lie inside the sphere but above the free surface (they carry a
+little mass from the top particles through the B-spline stencil) from acting as contact too
+early, which otherwise holds the material about one cell away from the sphere.
 
 The tangential velocity change is a traction-limited impulse:
 

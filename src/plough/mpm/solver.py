@@ -184,7 +184,8 @@ def step(s: State, c: Constants) -> None:
     transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf)
     transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v)
     contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
-                                   p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius, w.cbuf)
+                                   p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
+                                   w.cbuf)
     contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
                            sph.velocity, c.dt, c.interface_model, c.interface_params, w.contact_out)
     move_sphere(sph, c)
