@@ -112,7 +112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         return func(args)
-    except (ValueError, FileNotFoundError) as exc:
+    except (ValueError, FileNotFoundError, RuntimeError) as exc:  # RuntimeError: an unstable MPM run
         print(f"plough {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

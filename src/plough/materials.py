@@ -267,7 +267,15 @@ def interface_from_dict(d: dict[str, Any]) -> Interface:
     model = d.pop("model", None)
     if model not in INTERFACES:
         raise ValueError(f"interface.model = {model!r} is not one of {list(INTERFACES)}")
-    return INTERFACES[model](**d)
+    cls = INTERFACES[model]
+    allowed = {f.name for f in fields(cls)}
+    unknown = set(d) - allowed
+    if unknown:
+        raise ValueError(f"interface: unknown key(s) {sorted(unknown)} for model {model!r}; allowed: {sorted(allowed)}")
+    try:
+        return cls(**d)
+    except TypeError as exc:
+        raise ValueError(f"interface ({model}): {exc}") from None
 
 
 # ----------------------------------------------------------------------------- the paper's data

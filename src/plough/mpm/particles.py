@@ -72,6 +72,8 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
         coat = material_rows["coating"]
         # coating volume fraction of the cube [z - h/2, z + h/2] above z = -t
         frac = np.clip((x[:, 2] + 0.5 * h + t) / h, 0.0, 1.0)
+        frac[np.abs(frac - 1.0) < 1e-9] = 1.0  # exact multiples of h: full layers despite round-off
+        frac[frac < 1e-9] = 0.0
         mat_a[frac > 0] = coat
         mixed = (frac > 0) & (frac < 1)
         frac_a = np.where(frac > 0, frac, 1.0)

@@ -70,8 +70,16 @@ def _coerce(value: Any, type_name: str, where: str) -> Any:
     return number
 
 
+def _mapping(d: Any, where: str) -> dict[str, Any]:
+    if d is None:
+        return {}
+    if not isinstance(d, dict):
+        raise ValueError(f"{where} = {d!r} must be a mapping of keys to values")
+    return dict(d)
+
+
 def _from_dict(cls: type, d: dict[str, Any] | None, where: str) -> Any:
-    d = _to_si(dict(d or {}))
+    d = _to_si(_mapping(d, where))
     types = {f.name: str(f.type) for f in fields(cls)}
     unknown = set(d) - set(types)
     if unknown:
@@ -341,13 +349,13 @@ class Scene:
             raise ValueError(f"scene: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
         if "layers" not in d:
             raise ValueError("scene: the key 'layers' (substrate, coating, coating_thickness) is required")
-        lay = _to_si(dict(d["layers"]))
+        lay = _to_si(_mapping(d["layers"], "layers"))
         unknown = set(lay) - {"substrate", "coating", "coating_thickness_m"}
         if unknown:
             raise ValueError(f"layers: unknown key(s) {sorted(unknown)}")
         if "substrate" not in lay:
             raise ValueError("layers.substrate is required")
-        t = float(lay.get("coating_thickness_m", 0.0) or 0.0)
+        t = _coerce(lay.get("coating_thickness_m", 0.0) or 0.0, "float", "layers.coating_thickness_m")
         coating_spec = lay.get("coating")
         layers = Layers(
             substrate=material_from_spec(lay["substrate"], coating=False, where="layers.substrate"),
@@ -361,13 +369,16 @@ class Scene:
         if "load_N" in d:
             kwargs["load_N"] = _coerce(d["load_N"], "float", "load_N")
         if "interface" in d:
-            kwargs["interface"] = interface_from_dict(_to_si(dict(d["interface"])))
+            kwargs["interface"] = interface_from_dict(_to_si(_mapping(d["interface"], "interface")))
         for key, cls_ in (("sphere", Sphere), ("domain", Domain), ("sliding", Sliding),
                           ("discretisation", Discretisation), ("outputs", Outputs)):
             if key in d:
-                part = dict(d[key] or {})
+                part = _mapping(d[key], key)
                 if key == "outputs" and "steady_window" in part:
-                    part["steady_window"] = tuple(float(x) for x in part["steady_window"])
+                    window = part["steady_window"]
+                    if not (isinstance(window, list | tuple) and len(window) == 2):
+                        raise ValueError(f"outputs.steady_window = {window!r} must be [start, end] fractions")
+                    part["steady_window"] = tuple(_coerce(x, "float", "outputs.steady_window") for x in window)
                 kwargs[key] = _from_dict(cls_, part, key)
         return cls(**kwargs)
 

@@ -1,0 +1,299 @@
+"""Tests of plough.mpm.contact: the rigid sphere on the grid and the interface shear (eq. 8).
+
+A hand-made grid with random nodal masses, velocities and contact stresses is given to
+``sphere_contact``; the tests check the rules of the module docstring from the nodal data:
+impenetrability of approaching contact nodes (within one cell of the sphere surface or inside it,
+carrying a touching particle), untouched separating, non-touching and outside nodes, reaction =
+minus the impulses, the traction-limited tangential impulse that never reverses the slip, the
+energy account, and the consumption of the contact stress buffer.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from plough.materials import rigid_plastic
+from plough.mpm import contact as ct
+from plough.mpm.constitutive import pack_materials
+from plough.mpm.grid import Grid
+from plough.mpm.shape import bspline2
+
+DX = 1e-5
+SHAPE = np.array([12, 11, 13], dtype=np.int64)
+ORIGIN = np.array([-4e-5, -5e-5, -6e-5])
+NODES = Grid(origin=ORIGIN, dx=DX, shape=tuple(int(s) for s in SHAPE)).node_positions()
+N_NODES = NODES.shape[0]
+DT = 1e-3  # large, so that both the traction limit and the stop-the-slip limit occur
+
+
+def voigt_to_tensor(s):
+    return np.array([[s[0], s[5], s[4]], [s[5], s[1], s[3]], [s[4], s[3], s[2]]])
+
+
+def make_case(seed, centre=None, radius=3.3 * DX):
+    """Random grid state and contact buffer; pressure and kappa span many decades."""
+    rng = np.random.default_rng(seed)
+    if centre is None:
+        centre = ORIGIN + DX * (SHAPE - 1) / 2 + rng.uniform(-0.3, 0.3, 3) * DX
+    grid_m = rng.uniform(0.5e-3, 1.5e-3, N_NODES)
+    grid_m[rng.random(N_NODES) < 0.05] = 0.0
+    v_sphere = np.array([0.1, 0.0, -0.02])
+    # relative velocities over three decades: slips that the traction stops and slips it only slows
+    grid_v = v_sphere + rng.normal(0.0, 1.0, (N_NODES, 3)) * 10.0 ** rng.uniform(-4, -1, N_NODES)[:, None]
+    cbuf = np.zeros((N_NODES, ct.N_CBUF))
+    w = rng.uniform(0.1, 2.0, N_NODES)
+    p0 = 10.0 ** rng.uniform(5, 12, N_NODES) * np.where(rng.random(N_NODES) < 0.15, -1.0, 1.0)
+    dev = rng.normal(0.0, 0.2, (N_NODES, 6)) * np.abs(p0)[:, None]
+    sig = dev.copy()
+    sig[:, :3] -= p0[:, None]  # mostly compressive
+    kappa = 10.0 ** rng.uniform(5, 10, N_NODES)
+    cbuf[:, :6] = w[:, None] * sig
+    cbuf[:, 6] = w * kappa
+    cbuf[:, 7] = w
+    cbuf[:, 8] = rng.random(N_NODES) < 0.85  # a particle of the node touches the sphere
+    cbuf[rng.random(N_NODES) < 0.05, :] = 0.0  # nodes no particle reached
+    return dict(grid_m=grid_m, grid_v=grid_v, cbuf=cbuf, centre=np.asarray(centre, float), radius=radius,
+                v_sphere=v_sphere)
+
+
+def call(case, model, iparams):
+    grid_v = case["grid_v"].copy()
+    cbuf = case["cbuf"].copy()
+    out = np.zeros(ct.N_OUT)
+    ct.sphere_contact(case["grid_m"], grid_v, cbuf, ORIGIN, DX, SHAPE, case["centre"], case["radius"],
+                      case["v_sphere"], DT, model, np.asarray(iparams, float), out)
+    return grid_v, cbuf, out
+
+
+def classify(case):
+    rel = case["grid_v"] - case["v_sphere"]
+    d = NODES - case["centre"]
+    dist = np.linalg.norm(d, axis=1)
+    inside = dist < case["radius"] + DX  # the nodes the contact looks at: up to one cell outside
+    n = d / np.where(dist > 0, dist, 1.0)[:, None]
+    vn = (rel * n).sum(1)
+    contact = inside & (case["grid_m"] > 0) & (case["cbuf"][:, 8] > 0) & (vn < 0)
+    return inside, contact, n, vn, rel
+
+
+def expected_tau(model, iparams, pressure, kappa):
+    if model == ct.INTERFACE_PROPORTIONAL:
+        tau = iparams[0] * kappa
+    elif model == ct.INTERFACE_CONSTANT:
+        tau = iparams[0]
+    else:
+        tau = iparams[0] * max(pressure, 0.0) ** iparams[1]
+    return min(tau, kappa)
+
+
+MODELS = [
+    (ct.INTERFACE_PROPORTIONAL, [0.6, 0.0]),
+    (ct.INTERFACE_CONSTANT, [1.5e8, 0.0]),
+    (ct.INTERFACE_BOUNDARY_LAYER, [3.0, 0.95]),  # Cp large enough that some slips stop
+]
+CENTRES = [None, ORIGIN + DX * np.array([5.2, 4.9, 11.6])]  # inside / straddling the top of the grid
+
+
+# ----------------------------------------------------------------------------- normal direction
+@pytest.mark.parametrize("ci", range(len(CENTRES)))
+def test_impenetrability_and_untouched_nodes(ci):
+    case = make_case(10 + ci, centre=CENTRES[ci])
+    inside, contact, n, vn, _ = classify(case)
+    assert contact.sum() >= 10 and (inside & ~contact).sum() >= 10
+    # some approaching nodes are left alone only because no touching particle marks them
+    assert (inside & (case["grid_m"] > 0) & (vn < 0) & (case["cbuf"][:, 8] == 0)).sum() >= 3
+    grid_v, _, out = call(case, *MODELS[0])
+    rel_after = grid_v - case["v_sphere"]
+    # approaching nodes move with the sphere along the normal
+    np.testing.assert_allclose((rel_after[contact] * n[contact]).sum(1), 0.0, atol=1e-15)
+    # separating, massless or non-touching nodes near the sphere and all nodes farther out are untouched
+    np.testing.assert_array_equal(grid_v[~contact], case["grid_v"][~contact])
+    assert out[ct.OUT_NODES] == contact.sum()
+
+
+# ----------------------------------------------------------------------------- reaction
+@pytest.mark.parametrize("model,iparams", MODELS)
+def test_reaction_is_minus_the_impulses(model, iparams):
+    case = make_case(20 + model)
+    _, contact, n, _, _ = classify(case)
+    grid_v, _, out = call(case, model, iparams)
+    m = case["grid_m"][:, None]
+    dmv = m * (grid_v - case["grid_v"])
+    dn = (dmv * n).sum(1)[:, None] * n
+    dt_part = dmv - dn
+    fn = out[ct.OUT_FN:ct.OUT_FN + 3]
+    ft = out[ct.OUT_FT:ct.OUT_FT + 3]
+    scale = np.abs(dmv).sum() / DT
+    np.testing.assert_allclose(fn + ft, -dmv.sum(0) / DT, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(fn, -dn[contact].sum(0) / DT, rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(ft, -dt_part[contact].sum(0) / DT, rtol=0, atol=1e-12 * scale)
+    # the sphere pushes the material: the normal reaction points into the sphere (n . F_n <= 0 per node),
+    # so its component along the sphere's motion resists pressing
+    assert np.all((dn[contact] * n[contact]).sum(1) >= 0.0)
+
+
+def test_pressing_on_resting_material_gives_upward_normal_force():
+    rng = np.random.default_rng(3)
+    centre = ORIGIN + DX * np.array([5.5, 5.0, 9.0])
+    grid_m = rng.uniform(0.5e-3, 1.5e-3, N_NODES)
+    grid_v = np.zeros((N_NODES, 3))
+    cbuf = np.zeros((N_NODES, ct.N_CBUF))
+    cbuf[:, 8] = 1.0  # touching, but no stress: kappa = 0
+    out = np.zeros(ct.N_OUT)
+    v_sphere = np.array([0.0, 0.0, -0.05])
+    ct.sphere_contact(grid_m, grid_v, cbuf, ORIGIN, DX, SHAPE, centre, 3.3 * DX, v_sphere, DT,
+                      ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), out)
+    assert out[ct.OUT_FN + 2] > 0  # material pushes the sphere up
+    # nodes below the centre move down with the sphere's normal velocity
+    below = (np.linalg.norm(NODES - centre, axis=1) < 4.3 * DX) & (NODES[:, 2] < centre[2])
+    assert np.all(grid_v[below, 2] < 0)
+    # no stress reached the nodes: kappa = 0, so no interface shear at all
+    np.testing.assert_array_equal(out[ct.OUT_FT:ct.OUT_FT + 3], 0.0)
+
+
+# ----------------------------------------------------------------------------- tangential direction
+@pytest.mark.parametrize("model,iparams", MODELS)
+@pytest.mark.parametrize("ci", range(len(CENTRES)))
+def test_tangential_impulse_is_traction_limited_and_never_reverses(model, iparams, ci):
+    case = make_case(30 + 3 * model + ci, centre=CENTRES[ci])
+    _, contact, n, vn, rel = classify(case)
+    grid_v, _, out = call(case, model, iparams)
+    rel_after = grid_v - case["v_sphere"]
+    m = case["grid_m"]
+    cb = case["cbuf"]
+    n_limited = n_stopped = 0
+    area_xy = 0.0
+    for i in np.flatnonzero(contact):
+        t_before = rel[i] - vn[i] * n[i]
+        t_after = rel_after[i]  # no normal part left
+        vt_b, vt_a = np.linalg.norm(t_before), np.linalg.norm(t_after)
+        # same direction, smaller magnitude: the slip shrinks and never reverses
+        assert vt_a <= vt_b * (1 + 1e-12)
+        np.testing.assert_allclose(np.cross(t_before, t_after), 0.0, atol=1e-12 * vt_b * vt_b)
+        assert t_before @ t_after >= -1e-15
+        if cb[i, 7] > 0:
+            sig = voigt_to_tensor(cb[i, :6] / cb[i, 7])
+            pressure = -n[i] @ sig @ n[i]
+            kappa = cb[i, 6] / cb[i, 7]
+        else:
+            pressure = kappa = 0.0
+        tau = expected_tau(model, iparams, pressure, kappa)
+        assert tau <= kappa * (1 + 1e-15)
+        jn = -m[i] * vn[i]
+        area = DX * DX if pressure <= 0 else min(jn / (DT * pressure), DX * DX)
+        if n[i][2] < 0:
+            area_xy += area * -n[i][2]
+        limit = tau * area * DT
+        jt = m[i] * (vt_b - vt_a)  # loses digits to cancellation when jt << m vt
+        tol = 1e-12 * m[i] * vt_b
+        assert jt <= limit + tol
+        assert jt == pytest.approx(min(m[i] * vt_b, limit), rel=1e-9, abs=tol)
+        if limit < m[i] * vt_b:
+            n_limited += 1
+        elif limit > 0:
+            n_stopped += 1
+    # both regimes were exercised
+    assert n_limited > 0 and n_stopped > 0
+    assert out[ct.OUT_AREA_XY] == pytest.approx(area_xy, rel=1e-12)
+
+
+@pytest.mark.parametrize("model,iparams", MODELS)
+def test_energy_account_of_contact(model, iparams):
+    """Kinetic energy change = work of the sphere - interface dissipation - normal impact loss."""
+    case = make_case(40 + model)
+    _, contact, _, vn, _ = classify(case)
+    grid_v, _, out = call(case, model, iparams)
+    m = case["grid_m"]
+    dke = 0.5 * (m * ((grid_v**2).sum(1) - (case["grid_v"] ** 2).sum(1))).sum()
+    work = (m[:, None] * (grid_v - case["grid_v"]) @ case["v_sphere"]).sum()
+    assert out[ct.OUT_WORK] == pytest.approx(work, rel=1e-10)
+    assert out[ct.OUT_IMPACT] == pytest.approx(0.5 * (m[contact] * vn[contact] ** 2).sum(), rel=1e-12)
+    assert out[ct.OUT_DISSIPATION] >= 0.0
+    scale = 0.5 * (m * (case["grid_v"] ** 2).sum(1)).sum()
+    assert dke == pytest.approx(out[ct.OUT_WORK] - out[ct.OUT_DISSIPATION] - out[ct.OUT_IMPACT], abs=1e-10 * scale)
+
+
+def test_contact_buffer_is_consumed_where_the_contact_looks_only():
+    case = make_case(50)
+    inside, _, _, _, _ = classify(case)
+    _, cbuf, _ = call(case, *MODELS[0])
+    np.testing.assert_array_equal(cbuf[inside], 0.0)
+    np.testing.assert_array_equal(cbuf[~inside], case["cbuf"][~inside])
+
+
+# ----------------------------------------------------------------------------- interface shear
+def test_interface_shear_models():
+    kappa = 2.0e8
+    # proportional: f kappa
+    assert ct.interface_shear(ct.INTERFACE_PROPORTIONAL, np.array([0.6, 0.0]), 5e8, kappa) == pytest.approx(1.2e8)
+    assert ct.interface_shear(ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), 5e8, kappa) == pytest.approx(kappa)
+    # constant, capped at kappa
+    assert ct.interface_shear(ct.INTERFACE_CONSTANT, np.array([1.5e8, 0.0]), 0.0, kappa) == pytest.approx(1.5e8)
+    assert ct.interface_shear(ct.INTERFACE_CONSTANT, np.array([3.0e8, 0.0]), 0.0, kappa) == pytest.approx(kappa)
+    # boundary layer: Cp P^np with P in Pa (Table 5, zinc: 0.32 P^0.95), capped at kappa
+    bl = np.array([0.32, 0.95])
+    P = 1.0e8
+    assert ct.interface_shear(ct.INTERFACE_BOUNDARY_LAYER, bl, P, kappa) == pytest.approx(0.32 * P**0.95, rel=1e-12)
+    assert ct.interface_shear(ct.INTERFACE_BOUNDARY_LAYER, bl, P, 1.0e6) == pytest.approx(1.0e6)
+    assert ct.interface_shear(ct.INTERFACE_BOUNDARY_LAYER, bl, -P, kappa) == 0.0  # tension: no shear
+    assert ct.interface_shear(ct.INTERFACE_BOUNDARY_LAYER, np.array([1.34, 0.88]), 2.0e9, 1e12) == pytest.approx(
+        1.34 * 2.0e9**0.88, rel=1e-12)
+
+
+# ----------------------------------------------------------------------------- contact stress scatter
+def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
+    rng = np.random.default_rng(60)
+    centre = ORIGIN + DX * (SHAPE - 1) / 2 + np.array([0.1, -0.2, 0.3]) * DX
+    radius = 2.2 * DX
+    # particles on a shell around the sphere surface, well inside the grid
+    n = 200
+    d = rng.normal(size=(n, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    # upper half: some particles touch the sphere; lower half: none does (nodes there get no flag)
+    shell = np.where(d[:, 2] > 0, rng.uniform(0.7, 1.3, n), rng.uniform(1.25, 1.6, n))
+    x = centre + d * radius * shell[:, None]
+    stress = rng.normal(0.0, 1e8, (n, 6))
+    mass = rng.uniform(1e-4, 2e-4, n)
+    vol0 = np.full(n, (0.5 * DX) ** 3)
+    J = rng.uniform(0.8, 1.2, n)
+    eps_p = np.zeros(n)
+    temperature = np.full(n, 298.0)
+    table = pack_materials([rigid_plastic("coat", 450e6, coating=True), rigid_plastic("sub", 900e6, coating=False)])
+    mat_a = np.where(rng.random(n) < 0.5, 0, 1).astype(np.int32)
+    mat_b = np.ones(n, dtype=np.int32)
+    frac_a = np.where(rng.random(n) < 0.3, 0.4, 1.0)
+    near = (rng.random(n) < 0.7).astype(np.int8)
+    cbuf = np.zeros((N_NODES, ct.N_CBUF))
+    ct.scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near,
+                              ORIGIN, DX, SHAPE, centre, radius, cbuf)
+    # independent accumulation
+    sy = np.array([450e6 / 3, 900e6 / 3])
+    kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
+    touching = np.linalg.norm(x - centre, axis=1) - radius <= 0.5 * np.cbrt(vol0 * J)
+    assert 0 < (touching & (near == 1)).sum() < (near == 1).sum()
+    expected = np.zeros_like(cbuf)
+    reach = np.linalg.norm(NODES - centre, axis=1) < radius + DX
+    nz, ny = SHAPE[2], SHAPE[1]
+    for p in np.flatnonzero(near):
+        g = (x[p] - ORIGIN) / DX
+        stencil = [bspline2(gd) for gd in g]
+        for a in range(3):
+            for b in range(3):
+                for c in range(3):
+                    i, j, k = stencil[0][0] + a, stencil[1][0] + b, stencil[2][0] + c
+                    node = (i * ny + j) * nz + k
+                    if not reach[node]:
+                        continue
+                    w = stencil[0][1 + a] * stencil[1][1 + b] * stencil[2][1 + c] * mass[p]
+                    expected[node, :6] += w * stress[p]
+                    expected[node, 6] += w * kappa[p]
+                    expected[node, 7] += w
+                    if touching[p]:
+                        expected[node, 8] = 1.0
+    np.testing.assert_array_equal(cbuf[~reach], 0.0)
+    assert (cbuf[reach, 7] > 0).sum() > 10
+    assert 0 < (cbuf[reach, 8] > 0).sum() < (cbuf[reach, 7] > 0).sum()
+    np.testing.assert_allclose(cbuf, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())

@@ -1,0 +1,265 @@
+"""End-to-end tests of plough.mpm.run / solver / cli on a tiny scene (about 2000 particles).
+
+The scene is far too coarse for physics (h = 10 um against an expected ploughing depth of ~2 um);
+it checks the plumbing: load control, the results dataset and its metadata, the stability
+checks and the command line. Everything runs single-threaded (numba threads = 1) so that the
+run is deterministic and cheap on a loaded machine.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+import math
+
+import numba
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from plough import cli
+from plough.mpm import contact, solver, transfers
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+
+TINY = {
+    "name": "tiny",
+    "load_N": 1.0,
+    "sphere": {"radius_um": 200},
+    "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
+    "interface": {"model": "proportional", "f": 1.0},
+    "domain": {"radius_um": 80, "length_um": 400, "symmetric": True},
+    "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
+    "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
+    "outputs": {"steady_window": [0.5, 1.0], "records": 40},
+}
+#: Inertia-dominated variant that blows up within a few hundred steps (a particle is flung off the grid).
+UNSTABLE = {"sliding": {"distance_um": 200, "speed_m_s": 50.0}, "discretisation": {"particle_size_um": 10, "cfl": 1.0}}
+
+
+def scene_dict(**parts):
+    d = copy.deepcopy(TINY)
+    d.update(copy.deepcopy(parts))
+    return d
+
+
+@pytest.fixture(scope="module", autouse=True)
+def single_thread():
+    old = numba.get_num_threads()
+    numba.set_num_threads(1)
+    yield
+    numba.set_num_threads(old)
+
+
+@pytest.fixture(scope="module")
+def tiny_scene():
+    return Scene.from_dict(TINY)
+
+
+@pytest.fixture(scope="module")
+def tiny_run(tiny_scene):
+    return simulate(tiny_scene, progress=False, threads=1)
+
+
+# ----------------------------------------------------------------------------- the dataset
+def test_tiny_scene_passes_validation(tiny_scene):
+    a, dp = tiny_scene.expected_contact()
+    assert 2 * a <= tiny_scene.domain.radius_m
+    assert tiny_scene.sliding.distance_m + 4 * a <= tiny_scene.domain.length_m
+
+
+def test_results_are_present_and_finite(tiny_run):
+    for name in ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration", "Fz_mean", "Fx_mean",
+                 "max_particle_penetration"):
+        assert name in tiny_run, name
+        assert tiny_run[name].dims == ()
+        assert math.isfinite(float(tiny_run[name])), name
+    for name in ("Fx", "Fz", "Fx_pl", "Fx_sh", "depth", "external_work", "plastic_work", "time"):
+        assert np.all(np.isfinite(tiny_run[name].values)), name
+    assert float(tiny_run.dp) == pytest.approx(float(tiny_run.dg) + float(tiny_run.hpu), abs=1e-15)
+    assert float(tiny_run.dg) >= 0 and float(tiny_run.hpu) >= 0
+    assert 0 < float(tiny_run.mu) < 1.5
+    assert float(tiny_run.penetration) > 0
+
+
+def test_friction_parts_add_up(tiny_run):
+    ds = tiny_run
+    assert float(ds.mu) == pytest.approx(float(ds.mu_pl) + float(ds.mu_sh), abs=1e-12)
+    np.testing.assert_allclose(ds.Fx, ds.Fx_pl + ds.Fx_sh, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(ds.Fz, ds.Fz_pl + ds.Fz_sh, rtol=1e-12, atol=1e-15)
+    mask = ds.in_steady_window.values
+    assert mask.sum() >= 3
+    assert float(ds.mu) == pytest.approx(ds.Fx.values[mask].mean() / ds.Fz.values[mask].mean(), rel=1e-12)
+    # full-body forces with the mirror plane: no lateral force
+    assert ds.attrs["forces_and_energies"].startswith("full body (twice")
+    np.testing.assert_array_equal(ds.Fy, 0.0)
+
+
+def test_load_control_holds_the_normal_force(tiny_run, tiny_scene):
+    assert float(tiny_run.Fz_mean) == pytest.approx(tiny_scene.load_N, rel=0.05)
+
+
+def test_sliding_record(tiny_run, tiny_scene):
+    slid = tiny_run.sliding_distance.values
+    assert np.all(np.diff(slid) >= 0)
+    assert slid[-1] == pytest.approx(tiny_scene.sliding.distance_m, rel=0.02)
+    mask = tiny_run.in_steady_window.values
+    d = tiny_scene.sliding.distance_m
+    # the last record may overshoot the distance by one step; the window's tolerance is one record interval
+    tol = d / tiny_scene.outputs.records
+    assert np.all(slid[mask] >= 0.5 * d - 1e-12) and np.all(slid[mask] <= d + tol)
+    assert np.all((slid[~mask] < 0.5 * d) | (slid[~mask] > d + tol))
+    assert np.all(np.diff(tiny_run.time.values) > 0)
+    assert tiny_run.attrs["cost_steps"] > tiny_run.sliding_distance.size
+    assert tiny_run.attrs["cost_particles"] > 1000
+
+
+def test_last_record_is_in_the_steady_window(tiny_run):
+    assert bool(tiny_run.in_steady_window.values[-1])
+
+
+def test_no_particle_enters_the_sphere(tiny_run, tiny_scene):
+    h = tiny_scene.discretisation.particle_size_m
+    assert float(tiny_run.max_particle_penetration) < 0.5 * h
+    assert np.all(tiny_run.particle_penetration.values < 0.5 * h)
+
+
+def test_units_and_long_names(tiny_run):
+    for name, var in tiny_run.variables.items():
+        assert "units" in var.attrs, name
+        assert "long_name" in var.attrs, name
+    assert tiny_run.mu.attrs["units"] == "1" and tiny_run.Fx.attrs["units"] == "N"
+    assert tiny_run.dp.attrs["units"] == "m" and tiny_run.external_work.attrs["units"] == "J"
+
+
+def test_boolean_mask_has_units(tiny_run):
+    assert "units" in tiny_run.in_steady_window.attrs
+
+
+def test_scene_attribute_round_trips(tiny_run, tiny_scene):
+    assert Scene.from_dict(json.loads(tiny_run.attrs["scene"])) == tiny_scene
+    assert tiny_run.attrs["coating_representation"] == "uncoated"
+    assert json.loads(tiny_run.attrs["steady_window"]) == [0.5, 1.0]
+    assert tiny_run.attrs["plough_version"] and tiny_run.attrs["git_commit"]
+
+
+# ----------------------------------------------------------------------------- stability
+@pytest.fixture()
+def tiny_state(tiny_scene):
+    return solver.init(tiny_scene, n_chunks=2)
+
+
+@pytest.mark.parametrize("code", [transfers.BAD_LEFT_GRID, transfers.BAD_J, transfers.BAD_NONFINITE])
+def test_check_stability_names_step_sliding_distance_and_cause(tiny_state, code):
+    state, const = tiny_state
+    state.step = 1234
+    state.time = 5.0e-4
+    state.sphere.slid_m = 123.4e-6
+    state.work.acc[:] = 0.0
+    state.work.acc[1, transfers.ACC_BAD] = code
+    state.work.acc[1, transfers.ACC_BAD_INDEX] = 77
+    with pytest.raises(solver.SimulationError) as err:
+        solver.check_stability(state, const)
+    msg = str(err.value)
+    assert "step 1234" in msg and "sliding distance 123.4 um" in msg
+    assert solver.CAUSES[code] in msg
+    # all clear: no error
+    state.work.acc[:] = 0.0
+    solver.check_stability(state, const)
+
+
+def test_check_stability_flags_runaway_kinetic_energy(tiny_state):
+    state, const = tiny_state
+    state.step = 10
+    state.sphere.slid_m = 0.0
+    state.work.external_work = 1e-9
+    state.work.acc[:] = 0.0
+    state.work.acc[0, transfers.ACC_KINETIC] = 10.0 * (2e-9 + const.load_N * const.grid.dx)
+    with pytest.raises(solver.SimulationError, match=r"step 10 .*sliding distance 0\.0 um.*kinetic energy"):
+        solver.check_stability(state, const)
+
+
+def test_non_finite_particle_during_sliding_stops_the_run(tiny_state):
+    state, const = tiny_state
+    for _ in range(20000):
+        solver.step(state, const)
+        if state.sphere.phase == "slide" and state.sphere.slid_m >= 20e-6:
+            break
+    assert state.sphere.phase == "slide"
+    state.particles.v[0, 2] = np.nan
+    failing_step = state.step
+    with pytest.raises(solver.SimulationError) as err:
+        solver.step(state, const)
+    msg = str(err.value)
+    assert f"at step {failing_step} " in msg
+    slid_um = state.sphere.slid_m * 1e6  # the sphere had moved in the failing step
+    assert f"sliding distance {slid_um:.1f} um" in msg and slid_um >= 20.0
+    assert "non-finite" in msg
+
+
+def test_inertia_dominated_scene_raises_simulation_error():
+    scene = Scene.from_dict(scene_dict(**UNSTABLE))  # passes validation
+    with pytest.raises(solver.SimulationError, match=r"unstable run at step \d+ \(t = .*sliding distance .* um\)"):
+        simulate(scene, progress=False, threads=1)
+
+
+def test_lost_contact_while_sliding_is_an_error():
+    scene = Scene.from_dict(scene_dict(sliding={"distance_um": 200, "speed_m_s": 200.0}))
+    with pytest.raises(solver.SimulationError):
+        with np.errstate(invalid="ignore"):
+            simulate(scene, progress=False, threads=1)
+
+
+@pytest.mark.xfail(strict=True, raises=AssertionError,
+                   reason="contact/load control: on the tiny scene the sphere chatters while sliding: the "
+                   "per-step normal force is 0 on ~90% of the steps and ~11-16 N (for a 1 N load) on the others, the "
+                   "vertical speed swings between +-press speed every ~10 steps, and the vertical bouncing does more "
+                   "work than the friction force (external_work ~2.5 x integral of Fx dx)")
+def test_sphere_stays_in_contact_while_sliding(tiny_scene):
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    fz = []
+    while state.sphere.phase != "done":
+        solver.step(state, const)
+        if state.sphere.phase == "slide":
+            out = state.work.contact_out
+            fz.append(out[contact.OUT_FN + 2] + out[contact.OUT_FT + 2])
+    fz = np.array(fz)
+    assert np.mean(fz > 0) > 0.5
+
+
+# ----------------------------------------------------------------------------- command line
+def test_cli_writes_the_result(tmp_path, tiny_run):
+    scene_file = tmp_path / "tiny.yaml"
+    scene_file.write_text(yaml.safe_dump(TINY))
+    out = tmp_path / "res" / "tiny.nc"
+    assert cli.main(["mpm", str(scene_file), "-o", str(out), "--quiet", "--threads", "1"]) == 0
+    assert out.exists()
+    ds = xr.load_dataset(out)
+    assert Scene.from_dict(json.loads(ds.attrs["scene"])) == Scene.from_dict(TINY)
+    # same scene, same thread count: the same numbers as simulate()
+    assert float(ds.mu) == pytest.approx(float(tiny_run.mu), rel=1e-12)
+    assert not list(tmp_path.glob("res/.*part"))
+
+
+def test_cli_bad_scene_exits_2_and_writes_nothing(tmp_path, capsys):
+    scene_file = tmp_path / "bad.yaml"
+    bad = scene_dict()
+    bad["sphere"]["colour"] = "red"
+    scene_file.write_text(yaml.safe_dump(bad))
+    out = tmp_path / "bad.nc"
+    assert cli.main(["mpm", str(scene_file), "-o", str(out), "--quiet"]) == 2
+    assert not out.exists() and list(tmp_path.iterdir()) == [scene_file]
+    err = capsys.readouterr().err
+    assert "colour" in err and "Traceback" not in err and err.count("\n") == 1
+    assert cli.main(["mpm", str(tmp_path / "missing.yaml"), "-o", str(out), "--quiet"]) == 2
+    assert not out.exists()
+
+
+def test_cli_unstable_run_exits_2_without_traceback(tmp_path, capsys):
+    scene_file = tmp_path / "unstable.yaml"
+    scene_file.write_text(yaml.safe_dump(scene_dict(**UNSTABLE)))
+    out = tmp_path / "unstable.nc"
+    rc = cli.main(["mpm", str(scene_file), "-o", str(out), "--quiet", "--threads", "1"])
+    assert rc == 2 and not out.exists()
+    assert "unstable run at step" in capsys.readouterr().err

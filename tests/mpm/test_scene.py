@@ -1,0 +1,294 @@
+"""Tests of plough.mpm.scene (validation, units, YAML) and of the particle seeding it drives.
+
+Seeding is checked through ``solver.init(scene)``: particle positions fill the half cylinder
+(a quarter cylinder with the mirror plane), the particle straddling the coating interface carries
+both materials with the coating's volume fraction, and the masses are the layers' densities
+times mass scaling times volume.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+
+from plough.materials import DX56, ZINC_COATING, ProportionalShear, rigid_plastic
+from plough.mpm import io, solver
+from plough.mpm.constitutive import I_RHO
+from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
+
+EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.yaml"))
+
+
+def example_dict(name="uncoated_rigid_plastic"):
+    return yaml.safe_load((EXAMPLES[0].parent / f"{name}.yaml").read_text())
+
+
+# ----------------------------------------------------------------------------- round trips
+def test_the_three_examples_are_found():
+    assert {p.stem for p in EXAMPLES} == {"coated_rigid_plastic", "uncoated_rigid_plastic", "zinc_coated_steel"}
+
+
+@pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
+def test_round_trip_dict_and_yaml(path, tmp_path):
+    scene = Scene.from_yaml(path)
+    assert Scene.from_dict(scene.to_dict()) == scene
+    assert Scene.from_yaml(scene.to_yaml()) == scene
+    out = tmp_path / "scene.yaml"
+    scene.to_yaml(out)
+    assert Scene.from_yaml(out) == scene
+    assert Scene.from_yaml(str(out)) == scene
+    # equality is not vacuous
+    assert scene.with_(load_N=scene.load_N * 0.9) != scene
+
+
+def test_examples_parse_to_the_documented_values():
+    zinc = Scene.from_yaml(EXAMPLES[0].parent / "zinc_coated_steel.yaml")
+    assert zinc.layers.substrate == DX56 and zinc.layers.coating == ZINC_COATING
+    assert zinc.layers.coating_thickness_m == pytest.approx(15e-6)
+    assert zinc.sphere.radius_m == pytest.approx(500e-6)
+    assert zinc.load_N == 22.0
+    assert zinc.interface.Cp == 0.32 and zinc.interface.np == 0.95
+    coated = Scene.from_yaml(EXAMPLES[0].parent / "coated_rigid_plastic.yaml")
+    assert coated.layers.coating.flow.sigma_y_Pa == pytest.approx(450e6 / 3)
+    assert coated.layers.substrate.flow.sigma_y_Pa == pytest.approx(900e6 / 3)
+    assert coated.discretisation.mass_scaling == 1e6
+    assert coated.rate_scale == pytest.approx(1e-3 / 0.1)
+    # the slide is centred in the block
+    assert coated.start_x_m == pytest.approx(0.5 * (1000e-6 - 600e-6))
+
+
+# ----------------------------------------------------------------------------- units and coercion
+def test_unit_suffix_keys_are_converted_to_si():
+    d = example_dict()
+    d["sphere"] = {"radius_um": 250}
+    d["domain"] = {"radius_mm": 0.2, "length_um": 1000}
+    d["layers"]["substrate"] = {"rigid_plastic_hardness_MPa": 600}
+    s = Scene.from_dict(d)
+    assert s.sphere.radius_m == pytest.approx(250e-6, rel=1e-15)
+    assert s.domain.radius_m == pytest.approx(0.2e-3, rel=1e-15)
+    assert s.domain.length_m == pytest.approx(1e-3, rel=1e-15)
+    assert s.layers.substrate.flow.sigma_y_Pa == pytest.approx(200e6, rel=1e-15)
+    # a full material dict may use _GPa / _MPa too
+    mat = rigid_plastic("m", 600e6, coating=False).to_dict()
+    mat["youngs_modulus_GPa"] = mat.pop("youngs_modulus_Pa") / 1e9
+    d["layers"]["substrate"] = mat
+    assert Scene.from_dict(d).layers.substrate.youngs_modulus_Pa == pytest.approx(210e9)
+    # the same quantity twice is refused
+    d["sphere"] = {"radius_um": 250, "radius_m": 250e-6}
+    with pytest.raises(ValueError, match="radius_um.*radius_m"):
+        Scene.from_dict(d)
+
+
+def test_yaml_exponent_without_sign_is_coerced_to_a_number():
+    text = (EXAMPLES[0].parent / "uncoated_rigid_plastic.yaml").read_text()
+    text = text.replace("mass_scaling: 1.0e+6", "mass_scaling: 1.0e6").replace("load_N: 3.0", "load_N: 3.0e0")
+    assert "1.0e6" in text and "3.0e0" in text
+    raw = yaml.safe_load(text)
+    assert raw["discretisation"]["mass_scaling"] == "1.0e6"  # YAML 1.1 reads it as a string
+    s = Scene.from_yaml(text)
+    assert s.discretisation.mass_scaling == 1e6 and isinstance(s.discretisation.mass_scaling, float)
+    assert s.load_N == 3.0 and isinstance(s.load_N, float)
+    d = copy.deepcopy(raw)
+    d["discretisation"]["particles_per_cell"] = "2.0e0"
+    n = Scene.from_dict(d).discretisation.particles_per_cell
+    assert n == 2 and isinstance(n, int)
+
+
+# ----------------------------------------------------------------------------- bad input
+def _mutate(**changes):
+    d = example_dict()
+    for path, value in changes.items():
+        keys = path.split("__")
+        target = d
+        for k in keys[:-1]:
+            target = target.setdefault(k, {})
+        target[keys[-1]] = value
+    return d
+
+
+BAD = {
+    "negative radius": (_mutate(sphere__radius_um=-5), r"sphere\.radius_m"),
+    "unknown key in a part": (_mutate(sphere__colour="red"), r"unknown key.*colour"),
+    "unknown top-level key": (_mutate(colour="red"), r"unknown key.*colour"),
+    "unknown layers key": (_mutate(layers__thickness_um=3), r"layers.*unknown key.*thickness"),
+    "unknown material": (_mutate(layers__substrate="unobtainium"),
+                         r"layers\.substrate.*unobtainium.*dx56.*zinc_bulk.*zinc_coating"),
+    "cfl above 1": (_mutate(discretisation__cfl=1.5), r"discretisation\.cfl"),
+    "cfl zero": (_mutate(discretisation__cfl=0.0), r"discretisation\.cfl"),
+    "domain too small": (_mutate(domain__radius_um=60), r"domain\.radius_m"),
+    "domain too short": (_mutate(domain__length_um=500), r"domain\.length_m"),
+    "load too large": (_mutate(load_N=1e4), r"load_N"),
+    "negative load": (_mutate(load_N=-1.0), r"load_N"),
+    "coating thickness without coating": (_mutate(layers__coating_thickness_um=10), r"layers\.coating"),
+    "negative coating thickness": (_mutate(layers__coating_thickness_um=-3,
+                                           layers__coating={"rigid_plastic_hardness_MPa": 450}),
+                                   r"layers\.coating_thickness_m"),
+    "particles_per_cell 7": (_mutate(discretisation__particles_per_cell=7), r"discretisation\.particles_per_cell"),
+    "particles_per_cell 2.5": (_mutate(discretisation__particles_per_cell=2.5),
+                               r"discretisation\.particles_per_cell"),
+    "not a number": (_mutate(discretisation__cfl="abc"), r"discretisation\.cfl"),
+    "particles too coarse": (_mutate(discretisation__particle_size_um=60), r"discretisation\.particle_size_m"),
+    "mass scaling below 1": (_mutate(discretisation__mass_scaling=0.5), r"discretisation\.mass_scaling"),
+    "unknown control": (_mutate(sliding__control="force"), r"sliding\.control"),
+    "displacement without depth": (_mutate(sliding__control="displacement"), r"sliding\.depth_m"),
+    "unknown interface model": (_mutate(interface={"model": "magic"}), r"interface\.model"),
+    "symmetric not a bool": (_mutate(domain__symmetric="yes"), r"domain\.symmetric"),
+    "records too few": (_mutate(outputs__records=5), r"outputs\.records"),
+    "rigid-plastic extra key": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": 900, "foo": 1}),
+                                r"layers\.substrate.*foo"),
+}
+
+
+@pytest.mark.parametrize("case", BAD, ids=list(BAD))
+def test_bad_input_raises_value_error_naming_the_parameter(case):
+    d, pattern = BAD[case]
+    with pytest.raises(ValueError, match=pattern):
+        Scene.from_dict(d)
+
+
+def test_bad_input_in_constructors():
+    with pytest.raises(ValueError, match=r"discretisation\.cfl"):
+        Discretisation(cfl=1.01)
+    with pytest.raises(ValueError, match=r"domain\.radius_m"):
+        Domain(radius_m=-1.0)
+    with pytest.raises(ValueError, match=r"sliding\.speed_m_s"):
+        Sliding(speed_m_s=0.0)
+    with pytest.raises(ValueError, match=r"layers\.coating"):
+        Layers(substrate=DX56, coating_thickness_m=5e-6)
+    # a feasible scene assembled from parts, then made infeasible with with_()
+    s = Scene(layers=Layers(substrate=DX56), load_N=1.0, domain=Domain(radius_m=150e-6, length_m=1000e-6))
+    with pytest.raises(ValueError, match=r"domain\.radius_m"):
+        s.with_(domain=Domain(radius_m=40e-6, length_m=1000e-6))
+
+
+@pytest.mark.parametrize("interface", [{"model": "proportional", "g": 1.0}, {"model": "boundary_layer", "Cp": 0.3}])
+def test_unknown_or_missing_interface_key_is_a_value_error(interface):
+    with pytest.raises(ValueError, match="interface"):
+        Scene.from_dict(_mutate(interface=interface))
+
+
+def test_part_that_is_not_a_mapping_is_a_value_error():
+    with pytest.raises(ValueError, match="sphere"):
+        Scene.from_dict(_mutate(sphere=200))
+
+
+# ----------------------------------------------------------------------------- seeding
+def coated_scene(t_um=25.0, h_um=10.0, symmetric=True):
+    d = example_dict("coated_rigid_plastic")
+    d["layers"]["coating_thickness_um"] = t_um
+    d["discretisation"]["particle_size_um"] = h_um
+    d["domain"]["symmetric"] = symmetric
+    return Scene.from_dict(d)
+
+
+@pytest.fixture(scope="module")
+def coated_init():
+    scene = coated_scene()
+    state, const = solver.init(scene, n_chunks=1)
+    return scene, state.particles, const
+
+
+def test_straddling_particles_carry_both_materials(coated_init):
+    scene, p, const = coated_init
+    h = 10e-6
+    z = p.x[:, 2]
+    layer = np.rint(-z / h - 0.5).astype(int)  # 0 = top layer
+    np.testing.assert_allclose(z, -(layer + 0.5) * h, atol=1e-9 * h)
+    coat_row, sub_row = 0, 1
+    assert const.table[coat_row, I_RHO] == ZINC_COATING.density_kg_m3  # rigid-plastic coating: zinc data
+    assert const.table[sub_row, I_RHO] == DX56.density_kg_m3
+    straddle = layer == 2  # centre at z = -25 um = -t: half of its cube lies above the interface
+    assert straddle.sum() > 0
+    np.testing.assert_allclose(p.frac_a[straddle], 0.5, rtol=1e-12)
+    assert np.all(p.mat_a[straddle] == coat_row) and np.all(p.mat_b[straddle] == sub_row)
+    assert np.all(p.mat_a[straddle] != p.mat_b[straddle])
+    top = layer < 2
+    assert np.all(p.mat_a[top] == coat_row) and np.all(p.frac_a[top] == 1.0)
+    below = layer > 2
+    assert np.all(p.mat_a[below] == sub_row) and np.all(p.mat_b[below] == sub_row)
+    assert np.all(p.frac_a[below] == 1.0)
+
+
+def test_particles_fill_the_quarter_cylinder(coated_init):
+    scene, p, _ = coated_init
+    R, L, h = scene.domain.radius_m, scene.domain.length_m, scene.discretisation.particle_size_m
+    x = p.x
+    assert np.all((x[:, 0] > 0) & (x[:, 0] < L))
+    assert np.all(x[:, 1] > 0)
+    assert np.all(x[:, 2] < 0)
+    assert np.all(x[:, 1] ** 2 + x[:, 2] ** 2 <= R * R * (1 + 1e-12))
+    assert x[:, 2].max() == pytest.approx(-0.5 * h)  # the top faces lie on z = 0
+    np.testing.assert_allclose(p.vol0, h**3)
+    volume = p.vol0.sum()
+    assert volume == pytest.approx(math.pi * R * R * L / 4, rel=0.03)
+    assert np.all(p.J == 1.0) and np.all(p.v == 0.0) and np.all(p.stress == 0.0) and np.all(p.eps_p == 0.0)
+    assert np.all(p.temperature == scene.outputs.initial_temperature_K)
+
+
+def test_full_cylinder_without_symmetry():
+    scene = coated_scene(symmetric=False)
+    state, _ = solver.init(scene, n_chunks=1)
+    p = state.particles
+    R, L = scene.domain.radius_m, scene.domain.length_m
+    assert (p.x[:, 1] < 0).sum() == (p.x[:, 1] > 0).sum()
+    assert p.vol0.sum() == pytest.approx(math.pi * R * R * L / 2, rel=0.03)
+
+
+def test_masses_are_layer_density_times_mass_scaling_times_volume(coated_init):
+    scene, p, _ = coated_init
+    h, t = 10e-6, 25e-6
+    ms = scene.discretisation.mass_scaling
+    rho_c, rho_s = ZINC_COATING.density_kg_m3, DX56.density_kg_m3
+    layer = np.rint(-p.x[:, 2] / h - 0.5).astype(int)
+    coating_fraction = np.clip((t - layer * h) / h, 0.0, 1.0)  # of each layer's cube
+    v_coat = (coating_fraction * p.vol0).sum()
+    v_all = p.vol0.sum()
+    assert p.mass.sum() == pytest.approx(ms * (rho_c * v_coat + rho_s * (v_all - v_coat)), rel=1e-12)
+    for k, rho in ((0, rho_c), (1, rho_c), (2, 0.5 * (rho_c + rho_s)), (3, rho_s), (10, rho_s)):
+        np.testing.assert_allclose(p.mass[layer == k], rho * ms * h**3, rtol=1e-12)
+    # the coating volume is t times the top face's area (the block's top is R x L with symmetry)
+    R, L = scene.domain.radius_m, scene.domain.length_m
+    assert v_coat == pytest.approx(t * R * L, rel=0.03)
+
+
+def test_thin_coating_is_one_straddling_layer():
+    scene = coated_scene(t_um=3.0)
+    text = io.coating_representation(scene)
+    assert "0 full particle layer(s)" in text and "straddles" in text and "0.3" in text
+    p = solver.init(scene, n_chunks=1)[0].particles
+    top = p.x[:, 2] > -10e-6
+    np.testing.assert_allclose(p.frac_a[top], 0.3, rtol=1e-12)
+    assert np.all(p.mat_a[top] == 0) and np.all(p.mat_b[top] == 1)
+    assert np.all(p.mat_a[~top] == 1) and np.all(p.frac_a[~top] == 1.0)
+
+
+@pytest.mark.parametrize("t_um,full", [(25.0, 2), (20.0, 2), (10.0, 1)])
+def test_coating_representation(t_um, full):
+    text = io.coating_representation(coated_scene(t_um=t_um))
+    assert text.startswith(f"{full} full particle layer(s)")
+    assert ("straddles" in text) == (t_um % 10 != 0)
+    uncoated = Scene.from_dict(example_dict())
+    assert io.coating_representation(uncoated) == "uncoated"
+
+
+@pytest.mark.parametrize("t_m,h_m,full", [(30e-6, 10e-6, 3), (15e-6, 2.5e-6, 6), (15e-6, 5e-6, 3)])
+def test_coating_representation_exact_multiples_in_si(t_m, h_m, full):
+    d = example_dict("coated_rigid_plastic")
+    del d["layers"]["coating_thickness_um"]
+    d["layers"]["coating_thickness_m"] = t_m  # SI keys, as a script or a config in metres gives them
+    d["discretisation"]["particle_size_m"] = h_m
+    del d["discretisation"]["particle_size_um"]
+    text = io.coating_representation(Scene.from_dict(d))
+    assert text.startswith(f"{full} full particle layer(s)") and "straddles" not in text
+
+
+def test_interface_default_and_expected_contact():
+    s = Scene.from_dict(example_dict())
+    assert s.interface == ProportionalShear(f=1.0)
+    a, dp = s.expected_contact()
+    assert 0 < dp < a < s.sphere.radius_m

@@ -1,0 +1,345 @@
+"""Tests of plough.mpm.transfers: APIC/MLS P2G, the grid update and G2P (model.md section 2).
+
+Expected values are conservation laws and exact reproductions of the quadratic B-spline APIC
+scheme, computed here from the particle data alone:
+
+- P2G conserves mass, linear momentum and (APIC) angular momentum
+  sum_i x_i x m_i v_i = sum_p [x_p x m_p v_p + m_p dx^2/4 eps : C_p^T];
+- an affine velocity field v = v0 + A x with C = A survives P2G -> G2P exactly;
+- the MLS stress term of a uniform stress gives no force on interior nodes, and the force
+  transmitted across a plane between node layers equals -sigma . n x area (exact for a regular
+  particle lattice with two particles per cell);
+- the chunked scatter gives the same grid for any number of chunks.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+
+from plough.materials import rigid_plastic
+from plough.mpm import transfers as tr
+from plough.mpm.constitutive import I_G, I_K, pack_materials
+from plough.mpm.grid import FIXED, FREE, MIRROR, Grid, make_grid
+
+DX = 1e-5
+SHAPE = np.array([17, 16, 18], dtype=np.int64)  # non-cubic: catches index mix-ups
+ORIGIN = np.array([-3.0e-5, 2.0e-5, -7.0e-5])
+RHO = 7850.0
+STIFF = pack_materials([rigid_plastic("stiff", 1e15, coating=False)])  # never yields here
+
+
+def node_positions(origin=ORIGIN, dx=DX, shape=SHAPE) -> np.ndarray:
+    return Grid(origin=np.asarray(origin), dx=dx, shape=tuple(int(s) for s in shape)).node_positions()
+
+
+def random_particles(n=300, seed=0, lo_cells=3.0, hi_cells=None):
+    """n particles uniformly inside the grid, at least lo_cells from every face."""
+    rng = np.random.default_rng(seed)
+    hi = (SHAPE - 1 - lo_cells) if hi_cells is None else np.asarray(hi_cells)
+    x = ORIGIN + DX * rng.uniform(lo_cells, hi, size=(n, 3))
+    vol0 = rng.uniform(0.5, 1.5, n) * (0.5 * DX) ** 3
+    J = rng.uniform(0.9, 1.1, n)
+    mass = RHO * vol0 * rng.uniform(0.8, 1.2, n)
+    v = rng.normal(0.0, 0.1, (n, 3))
+    return rng, x, v, vol0, J, mass
+
+
+def p2g_update(x, v, C, stress, vol0, J, mass, dt, n_chunks=1, flags=None):
+    n_nodes = int(np.prod(SHAPE))
+    buf = tr.allocate_grid_buffers(n_chunks, n_nodes)
+    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, dt, SHAPE, buf)
+    grid_m = np.zeros(n_nodes)
+    grid_v = np.zeros((n_nodes, 3))
+    if flags is None:
+        flags = np.full(n_nodes, FREE, dtype=np.int8)
+    tr.grid_update(buf, flags, grid_m, grid_v)
+    return buf, grid_m, grid_v
+
+
+def random_sym_stress(rng, n, scale=1e8):
+    return rng.normal(0.0, scale, (n, 6))
+
+
+# ----------------------------------------------------------------------------- conservation
+@pytest.mark.parametrize("with_C", [False, True])
+def test_p2g_conserves_mass_and_linear_momentum(with_C):
+    rng, x, v, vol0, J, mass = random_particles(seed=1)
+    n = x.shape[0]
+    C = rng.normal(0.0, 1e4, (n, 3, 3)) if with_C else np.zeros((n, 3, 3))
+    stress = np.zeros((n, 6))
+    buf, grid_m, grid_v = p2g_update(x, v, C, stress, vol0, J, mass, dt=1e-8)
+    assert grid_m.sum() == pytest.approx(mass.sum(), rel=1e-13)
+    assert buf[0, :, 0].sum() == pytest.approx(mass.sum(), rel=1e-13)
+    p_particles = (mass[:, None] * v).sum(0)
+    p_grid = (grid_m[:, None] * grid_v).sum(0)
+    scale = (mass[:, None] * np.abs(v)).sum()
+    np.testing.assert_allclose(p_grid, p_particles, rtol=0, atol=1e-12 * scale)
+    # the grid really carries the APIC term: nodal velocities differ when C is set
+    if with_C:
+        _, _, grid_v0 = p2g_update(x, v, np.zeros_like(C), stress, vol0, J, mass, dt=1e-8)
+        assert np.abs(grid_v - grid_v0).max() > 1e-3
+
+
+def test_p2g_stress_adds_no_net_momentum_or_angular_momentum():
+    """Any (symmetric) particle stress: internal forces sum to zero and exert no net torque."""
+    rng, x, v, vol0, J, mass = random_particles(seed=2)
+    n = x.shape[0]
+    C = np.zeros((n, 3, 3))
+    stress = random_sym_stress(rng, n)
+    dt = 1e-7
+    _, grid_m, grid_v = p2g_update(x, np.zeros_like(v), C, stress, vol0, J, mass, dt)
+    mom = grid_m[:, None] * grid_v
+    # scale of individual nodal impulses, to judge round-off
+    scale = np.abs(mom).max() * grid_m.size
+    assert scale > 0
+    np.testing.assert_allclose(mom.sum(0), 0.0, atol=1e-13 * scale)
+    L = np.cross(node_positions(), mom).sum(0)
+    np.testing.assert_allclose(L, 0.0, atol=1e-13 * scale * np.abs(node_positions()).max())
+
+
+def test_apic_p2g_conserves_angular_momentum():
+    """sum_i x_i x m_i v_i = sum_p x_p x m_p v_p + m_p dx^2/4 (C_zy - C_yz, C_xz - C_zx, C_yx - C_xy)."""
+    rng, x, v, vol0, J, mass = random_particles(seed=3)
+    n = x.shape[0]
+    C = rng.normal(0.0, 1e4, (n, 3, 3))
+    stress = random_sym_stress(rng, n)  # symmetric stress: no torque
+    _, grid_m, grid_v = p2g_update(x, v, C, stress, vol0, J, mass, dt=1e-8)
+    L_grid = np.cross(node_positions(), grid_m[:, None] * grid_v).sum(0)
+    spin = np.stack([C[:, 2, 1] - C[:, 1, 2], C[:, 0, 2] - C[:, 2, 0], C[:, 1, 0] - C[:, 0, 1]], axis=1)
+    L_part = (np.cross(x, mass[:, None] * v) + (mass * DX * DX / 4.0)[:, None] * spin).sum(0)
+    scale = (mass * (np.linalg.norm(x, axis=1) * np.linalg.norm(v, axis=1)
+                     + DX * DX * np.abs(spin).sum(1))).sum()
+    np.testing.assert_allclose(L_grid, L_part, rtol=0, atol=1e-11 * scale)
+    # the spin term matters: without it the balance fails
+    assert np.abs(L_grid - np.cross(x, mass[:, None] * v).sum(0)).max() > 1e-3 * np.abs(L_part).max()
+
+
+# ----------------------------------------------------------------------------- affine field
+def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=None, sphere_r=1e-6,
+            near_dist=3 * DX, grid_lo=None, grid_hi=None, table=STIFF):
+    n = x.shape[0]
+    eps_p = np.zeros(n)
+    temperature = np.full(n, 298.0)
+    mat = np.zeros(n, dtype=np.int32)
+    frac = np.ones(n)
+    near = np.zeros(n, dtype=np.int8)
+    acc = np.zeros((n_chunks, tr.N_ACC))
+    if sphere_c is None:
+        sphere_c = np.array([1.0, 1.0, 1.0])  # far away
+    lo = ORIGIN + DX if grid_lo is None else grid_lo
+    hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
+    tr.g2p(grid_v, ORIGIN, DX, dt, SHAPE, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat, mat, frac,
+           table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi)
+    return acc, near, eps_p
+
+
+def test_affine_velocity_field_is_reproduced_exactly():
+    rng, x, _, vol0, _, mass = random_particles(seed=4)
+    n = x.shape[0]
+    v0 = np.array([0.1, -0.05, 0.02])
+    A = rng.normal(0.0, 1e3, (3, 3))  # not symmetric: checks C = dv_i/dx_j, not its transpose
+    v = v0 + x @ A.T
+    C = np.repeat(A[None], n, axis=0)
+    J = np.ones(n)
+    stress = np.zeros((n, 6))
+    dt = 1e-9
+    _, grid_m, grid_v = p2g_update(x, v, C, stress, vol0, J, mass, dt)
+    nodes = node_positions()
+    has = grid_m > 0
+    np.testing.assert_allclose(grid_v[has], v0 + nodes[has] @ A.T, rtol=0, atol=1e-12)
+
+    x_old = x.copy()
+    v_new = np.zeros_like(v)
+    C_new = np.zeros_like(C)
+    acc, _, eps_p = run_g2p(grid_v, x, v_new, C_new, stress, J, vol0, mass, dt)
+    v_exact = v0 + x_old @ A.T
+    np.testing.assert_allclose(v_new, v_exact, rtol=0, atol=1e-10 * np.abs(v_exact).max())
+    np.testing.assert_allclose(C_new, C, rtol=0, atol=1e-10 * np.abs(A).max())
+    np.testing.assert_allclose(x, x_old + dt * v_new, rtol=0, atol=1e-20)
+    np.testing.assert_allclose(J, np.linalg.det(np.eye(3) + dt * A), rtol=1e-13)
+    # elastic stress from zero: 2 G dt dev(sym A) + K (J - 1) I, Voigt xx yy zz yz xz xy
+    K, G = STIFF[0, I_K], STIFF[0, I_G]
+    D = 0.5 * (A + A.T)
+    dev = D - np.trace(D) / 3 * np.eye(3)
+    sig = 2 * G * dt * dev + K * (J[0] - 1.0) * np.eye(3)
+    expected = np.array([sig[0, 0], sig[1, 1], sig[2, 2], sig[1, 2], sig[0, 2], sig[0, 1]])
+    np.testing.assert_allclose(stress, np.tile(expected, (n, 1)), rtol=1e-8, atol=1e-8 * np.abs(sig).max())
+    assert np.all(eps_p == 0.0)
+    assert acc[0, tr.ACC_BAD] == tr.BAD_NONE
+    assert acc[0, tr.ACC_KINETIC] == pytest.approx(0.5 * (mass * (v_exact**2).sum(1)).sum(), rel=1e-10)
+    assert acc[0, tr.ACC_PLASTIC_WORK] == 0.0
+
+
+def test_g2p_near_flags_and_penetration():
+    _, x, _, vol0, J, mass = random_particles(seed=5)
+    n = x.shape[0]
+    grid_v = np.zeros((int(np.prod(SHAPE)), 3))
+    centre = x.mean(0) + np.array([0.0, 0.0, 4 * DX])
+    r = 2.5 * DX
+    acc, near, _ = run_g2p(grid_v, x.copy(), np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros((n, 6)), J, vol0, mass,
+                           1e-9, n_chunks=2, sphere_c=centre, sphere_r=r, near_dist=DX)
+    dist = np.linalg.norm(x - centre, axis=1)
+    np.testing.assert_array_equal(near, (dist < r + DX).astype(np.int8))
+    assert 0 < near.sum() < n
+    assert acc[:, tr.ACC_PENETRATION].max() == pytest.approx((r - dist).max(), rel=1e-12)
+
+
+@pytest.mark.parametrize("case", ["left_grid", "J", "nonfinite"])
+def test_g2p_reports_instabilities(case):
+    _, x, v, vol0, J, mass = random_particles(seed=6)
+    n = x.shape[0]
+    n_nodes = int(np.prod(SHAPE))
+    grid_v = np.zeros((n_nodes, 3))
+    lo, hi = None, None
+    dt = 1e-9
+    if case == "left_grid":
+        hi = ORIGIN + DX * (SHAPE - 2)
+        hi[0] = np.sort(x[:, 0])[-5]  # five particles lie beyond the allowed box
+        expected = tr.BAD_LEFT_GRID
+        offenders = np.flatnonzero(x[:, 0] > hi[0])
+    elif case == "J":
+        grid_v[:] = 0.0
+        A = -2.0e3 * np.eye(3)  # 1 + dt A = -1 with dt = 1e-3: volume inverts
+        grid_v = node_positions() @ A.T
+        dt = 1e-3
+        lo, hi = ORIGIN - 1.0, ORIGIN + 1.0  # the advected particles may go anywhere
+        expected = tr.BAD_J
+        offenders = np.arange(n)
+    else:
+        node = ((6 * SHAPE[1] + 6) * SHAPE[2]) + 7
+        grid_v[node, 1] = np.nan
+        expected = tr.BAD_NONFINITE
+        offenders = None
+    acc, _, _ = run_g2p(grid_v, x, np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros((n, 6)), J, vol0, mass, dt,
+                        n_chunks=3, grid_lo=lo, grid_hi=hi)
+    codes = acc[:, tr.ACC_BAD]
+    assert codes.max() == expected
+    c = int(np.argmax(codes))
+    p = int(acc[c, tr.ACC_BAD_INDEX])
+    assert c * n // 3 <= p < (c + 1) * n // 3  # the index names a particle of that chunk
+    if offenders is not None:
+        assert p in offenders
+    else:
+        assert not np.isfinite(x[p]).all()
+    # chunks without trouble report none
+    for cc in range(3):
+        if codes[cc] == tr.BAD_NONE:
+            assert acc[cc, tr.ACC_BAD_INDEX] == -1
+
+
+# ----------------------------------------------------------------------------- stress term
+def lattice_block(n_side=16, first_cell=4, ppc=2):
+    """A regular lattice, ppc particles per cell and direction, filling n_side / ppc cells per side."""
+    h = DX / ppc
+    k = np.arange(n_side)
+    idx = np.stack(np.meshgrid(k, k, k, indexing="ij"), -1).reshape(-1, 3)
+    x = ORIGIN + first_cell * DX + (idx + 0.5) * h
+    n = x.shape[0]
+    vol0 = np.full(n, h**3)
+    return x, vol0, RHO * vol0, h
+
+
+@pytest.mark.parametrize("J_value", [1.0, 1.3])
+def test_uniform_stress_interior_nodes_free_and_traction_across_planes(J_value):
+    x, vol0, mass, h = lattice_block()
+    n = x.shape[0]
+    sig = np.array([[3.0e8, 0.7e8, -0.4e8],
+                    [0.7e8, -1.0e8, 1.1e8],
+                    [-0.4e8, 1.1e8, 2.0e8]])
+    voigt = np.array([sig[0, 0], sig[1, 1], sig[2, 2], sig[1, 2], sig[0, 2], sig[0, 1]])
+    stress = np.tile(voigt, (n, 1))
+    J = np.full(n, J_value)
+    dt = 1e-7
+    _, grid_m, grid_v = p2g_update(x, np.zeros((n, 3)), np.zeros((n, 3, 3)), stress, vol0, J, mass, dt)
+    force = grid_m[:, None] * grid_v / dt
+    g = np.rint((node_positions() - ORIGIN) / DX).astype(int)
+    # the block spans grid units [4, 12]; nodes in [6, 10]^3 see a full, symmetric particle stencil
+    interior = np.all((g >= 6) & (g <= 10), axis=1)
+    fmax = np.abs(force).max()
+    assert fmax > 0
+    np.testing.assert_allclose(force[interior], 0.0, atol=1e-10 * fmax)
+    np.testing.assert_allclose(force.sum(0), 0.0, atol=1e-12 * fmax * force.shape[0])
+    # across the mid-plane of the block (between node layers 8 and 9) the block on the + side
+    # is pulled by -sigma . n times the cross-section (times J: the particle volume is vol0 J)
+    area = (16 * h) ** 2
+    for d in range(3):
+        plus = g[:, d] >= 9
+        np.testing.assert_allclose(force[plus].sum(0), -sig[:, d] * area * J_value, rtol=1e-10,
+                                   atol=1e-10 * np.abs(sig).max() * area)
+
+
+# ----------------------------------------------------------------------------- chunks
+def test_chunked_scatter_gives_same_grid():
+    rng, x, v, vol0, J, mass = random_particles(n=301, seed=7)
+    n = x.shape[0]
+    C = rng.normal(0.0, 1e4, (n, 3, 3))
+    stress = random_sym_stress(rng, n)
+    results = {}
+    for n_chunks in (1, 2, 3):
+        buf, grid_m, grid_v = p2g_update(x, v, C, stress, vol0, J, mass, 1e-8, n_chunks=n_chunks)
+        results[n_chunks] = (grid_m, grid_v)
+        # chunk c holds exactly the scatter of its own contiguous particle slice
+        for c in range(n_chunks):
+            sl = slice(c * n // n_chunks, (c + 1) * n // n_chunks)
+            one = tr.allocate_grid_buffers(1, buf.shape[1])
+            tr.p2g(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl], ORIGIN, DX, 1e-8, SHAPE, one)
+            np.testing.assert_array_equal(buf[c], one[0])
+    m1, v1 = results[1]
+    vscale = np.abs(v1).max()
+    for k in (2, 3):
+        mk, vk = results[k]
+        np.testing.assert_allclose(mk, m1, rtol=1e-13, atol=1e-13 * m1.max())
+        np.testing.assert_allclose(vk, v1, rtol=0, atol=1e-12 * vscale)
+
+
+def test_p2g_zeroes_stale_buffer():
+    """A buffer reused from a previous step is overwritten, not accumulated."""
+    _, x, v, vol0, J, mass = random_particles(seed=8)
+    n = x.shape[0]
+    C, stress = np.zeros((n, 3, 3)), np.zeros((n, 6))
+    buf = tr.allocate_grid_buffers(2, int(np.prod(SHAPE)))
+    buf[:] = 123.0
+    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, buf)
+    assert buf[:, :, 0].sum() == pytest.approx(mass.sum(), rel=1e-13)
+
+
+# ----------------------------------------------------------------------------- grid update
+def test_grid_update_boundary_conditions():
+    rng = np.random.default_rng(9)
+    n_nodes = 500
+    buf = np.zeros((3, n_nodes, 4))
+    buf[:, :, 0] = rng.uniform(0.0, 1.0, (3, n_nodes))
+    buf[:, :, 1:] = rng.normal(0.0, 1.0, (3, n_nodes, 3))
+    buf[:, :20, 0] = 0.0  # empty nodes
+    flags = rng.choice(np.array([FREE, FIXED, MIRROR], dtype=np.int8), n_nodes)
+    grid_m = np.full(n_nodes, -1.0)
+    grid_v = np.full((n_nodes, 3), 99.0)
+    tr.grid_update(buf, flags, grid_m, grid_v)
+    m = buf[:, :, 0].sum(0)
+    mom = buf[:, :, 1:].sum(0)
+    np.testing.assert_allclose(grid_m, m, rtol=1e-15)
+    empty = m <= 0
+    free = (flags == FREE) & ~empty
+    fixed = flags == FIXED
+    mirror = (flags == MIRROR) & ~empty
+    assert free.any() and fixed.any() and mirror.any() and empty.any()
+    np.testing.assert_allclose(grid_v[free], mom[free] / m[free, None], rtol=1e-14)
+    np.testing.assert_array_equal(grid_v[fixed], 0.0)
+    np.testing.assert_array_equal(grid_v[empty], 0.0)
+    np.testing.assert_array_equal(grid_v[mirror, 1], 0.0)
+    np.testing.assert_allclose(grid_v[mirror][:, [0, 2]], mom[mirror][:, [0, 2]] / m[mirror, None], rtol=1e-14)
+
+
+def test_make_grid_covers_block_with_padding():
+    L, R, dx, head = 400e-6, 80e-6, 20e-6, 30e-6
+    for symmetric in (True, False):
+        g = make_grid(L, R, symmetric, dx, head)
+        lo = np.array([0.0, 0.0 if symmetric else -R, -R])
+        hi = np.array([L, R, head])
+        assert np.all(g.origin <= lo - 3 * dx + 1e-12 * dx)
+        assert np.all(g.upper >= hi + 3 * dx - 1e-12 * dx)
+        assert g.node_positions().shape == (g.n_nodes, 3)
+        assert math.isclose(g.node_positions()[1, 2] - g.node_positions()[0, 2], dx)
