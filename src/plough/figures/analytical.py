@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import os
 
-import numpy as np
 import xarray as xr
 
 from plough.figures.style import COLOURS, LABELS, caption, new_figure, save, shade_where
@@ -105,11 +104,3 @@ def plot_fig22(ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
 
 PLOTTERS = {"fig03": plot_fig03, "fig04": plot_fig04, "fig22": plot_fig22}
 
-
-def plot(figure: str, ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
-    if figure not in PLOTTERS:
-        raise ValueError(f"figure = {figure!r} is unknown; allowed: {sorted(PLOTTERS)}")
-    for name, var in ds.data_vars.items():
-        if var.size == 0 or (var.dtype.kind == "f" and not np.isfinite(var.values).any()):
-            raise ValueError(f"{figure}: variable {name!r} has no data; refusing to draw an empty plot")
-    PLOTTERS[figure](ds, outputs)

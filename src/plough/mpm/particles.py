@@ -75,14 +75,10 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
         frac[np.abs(frac - 1.0) < 1e-9] = 1.0  # exact multiples of h: full layers despite round-off
         frac[frac < 1e-9] = 0.0
         mat_a[frac > 0] = coat
-        mixed = (frac > 0) & (frac < 1)
         frac_a = np.where(frac > 0, frac, 1.0)
-    else:
-        mixed = np.zeros(n, dtype=bool)
     rho = frac_a * densities[mat_a] + (1.0 - frac_a) * densities[mat_b]
     vol0 = np.full(n, h**3)
     mass = rho * scene.discretisation.mass_scaling * vol0
-    del mixed
     return Particles(
         x=x, v=np.zeros((n, 3)), C=np.zeros((n, 3, 3)), stress=np.zeros((n, 6)), J=np.ones(n), vol0=vol0,
         mass=mass, eps_p=np.zeros(n), temperature=np.full(n, scene.outputs.initial_temperature_K),
