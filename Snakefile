@@ -15,6 +15,7 @@ validate(config, "workflow/schemas/config.schema.yaml")
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/analytical.smk"
+include: "workflow/rules/mpm.smk"
 include: "workflow/rules/figures.smk"
 
 

@@ -7,9 +7,9 @@ import os
 import numpy as np
 import xarray as xr
 
-from plough.figures import analytical
+from plough.figures import analytical, mpm
 
-PLOTTERS = dict(analytical.PLOTTERS)
+PLOTTERS = {**analytical.PLOTTERS, **mpm.PLOTTERS}
 
 
 def plot(figure: str, ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:

@@ -70,13 +70,16 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
     x0 = scene.start_x_m
     d = scene.sliding.distance_m
     lo, _ = scene.outputs.steady_window
+    # sections where the sphere has passed and the material has unloaded: 1.25 contact radii behind
+    # the sphere's final centre (a quarter radius behind the trailing edge), inside the steady window,
+    # or past the initial dent if the window is too short (the positions are stored as section_x)
+    x_hi = sphere_x_end - 1.25 * contact_radius
     x_lo = x0 + lo * d
-    x_hi = sphere_x_end - 2.5 * contact_radius
     if x_hi <= x_lo:
-        x_lo = x0 + 2.0 * contact_radius
+        x_lo = x0 + 1.25 * contact_radius
     if x_hi <= x_lo:
         raise ValueError("the slide is too short to measure a residual groove behind the sphere "
-                         "(sliding.distance_m must exceed ~5 contact radii)")
+                         "(sliding.distance_m must exceed ~2.7 contact radii)")
     sections = np.linspace(x_lo, x_hi, scene.outputs.profile_sections)
     y_max = scene.domain.radius_m
     y_min = 0.0 if scene.domain.symmetric else -y_max
@@ -95,8 +98,73 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
     return centres, np.nanmean(prof, axis=0), sections
 
 
+def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coating_row: int,
+                      contact_radius: float, sections: np.ndarray) -> tuple[dict, dict]:
+    """What the figures draw of the final state, small enough to keep in every result file.
+
+    * ``height_map`` (hx, hy): top surface height on an h x h raster around the track (Fig. 14a/b);
+    * ``buried_profile_z`` (y): the material line that started at ``outputs.buried_profile_depth_m``
+      below the surface, in the residual sections (Fig. 17: the coating interface for t = 15 um);
+    * ``midplane_*``: particles of the first row next to the mirror plane around the sphere, the side
+      view of the coating piling up ahead of it (Fig. 12a);
+    * ``section_*``: particles of the middle residual cross-section (Fig. 14d).
+    """
+    h = scene.discretisation.particle_size_m
+    x, y, z = p.x[:, 0], p.x[:, 1], p.x[:, 2]
+    coat = np.where(p.mat_a == coating_row, p.frac_a, 0.0).astype(np.float32)
+    top = z + 0.5 * h * np.cbrt(p.J)
+    xs_edges = np.arange(scene.start_x_m - 2.0 * contact_radius, sphere_centre[0] + 2.0 * contact_radius + h, h)
+    ys_edges = np.arange(0.0 if scene.domain.symmetric else -3.0 * contact_radius, 3.0 * contact_radius + h, h)
+    ix = np.digitize(x, xs_edges) - 1
+    iy = np.digitize(y, ys_edges) - 1
+    ok = (ix >= 0) & (ix < xs_edges.size - 1) & (iy >= 0) & (iy < ys_edges.size - 1)
+    hmap = np.full((xs_edges.size - 1, ys_edges.size - 1), -np.inf)
+    np.maximum.at(hmap, (ix[ok], iy[ok]), top[ok])
+    hmap[~np.isfinite(hmap)] = np.nan
+
+    depth = scene.outputs.buried_profile_depth_m
+    y_edges = np.arange(0.0 if scene.domain.symmetric else -scene.domain.radius_m, scene.domain.radius_m + 0.5 * h, h)
+    in_sections = np.zeros(p.n, dtype=bool)
+    for xs in sections:
+        in_sections |= np.abs(x - xs) < 0.5 * h
+    line = in_sections & (np.abs(p.z0 + depth) <= 0.5 * h + 1e-12)
+    iyl = np.clip(np.digitize(y[line], y_edges) - 1, 0, y_edges.size - 2)
+    total = np.bincount(iyl, weights=(z - p.z0)[line], minlength=y_edges.size - 1)
+    count = np.bincount(iyl, minlength=y_edges.size - 1)
+    buried = np.where(count > 0, -depth + total / np.maximum(count, 1), np.nan)
+
+    mid = (np.abs(y) < h) & (np.abs(x - sphere_centre[0]) < 4.0 * contact_radius) & (z > -3.0 * contact_radius)
+    xs_mid = sections[len(sections) // 2]
+    sec = np.abs(x - xs_mid) < 0.5 * h
+    f32 = np.float32
+    variables = {
+        "height_map": (("hx", "hy"), hmap.astype(f32), {"units": "m", "long_name": "residual top-surface height",
+                                                        "allow_missing": 1}),
+        "buried_profile_z": (("y",), buried, {"units": "m", "allow_missing": 1,
+                                              "long_name": f"height of the material line that started {depth:g} m "
+                                                           "below the surface, in the residual sections"}),
+        "midplane_x": (("midplane_particle",), x[mid].astype(f32), {"units": "m", "long_name": "particle x"}),
+        "midplane_z": (("midplane_particle",), z[mid].astype(f32), {"units": "m", "long_name": "particle z"}),
+        "midplane_coating": (("midplane_particle",), coat[mid], {"units": "1", "long_name": "coating fraction"}),
+        "midplane_eps_p": (("midplane_particle",), p.eps_p[mid].astype(f32),
+                           {"units": "1", "long_name": "equivalent plastic strain"}),
+        "section_y": (("section_particle",), y[sec].astype(f32), {"units": "m", "long_name": "particle y"}),
+        "section_z": (("section_particle",), z[sec].astype(f32), {"units": "m", "long_name": "particle z"}),
+        "section_coating": (("section_particle",), coat[sec], {"units": "1", "long_name": "coating fraction"}),
+        "section_eps_p": (("section_particle",), p.eps_p[sec].astype(f32),
+                          {"units": "1", "long_name": "equivalent plastic strain"}),
+    }
+    coords = {
+        "hx": (("hx",), 0.5 * (xs_edges[1:] + xs_edges[:-1]), {"units": "m", "long_name": "x of the height map"}),
+        "hy": (("hy",), 0.5 * (ys_edges[1:] + ys_edges[:-1]), {"units": "m", "long_name": "y of the height map"}),
+    }
+    attrs = {"sphere_centre_end_m": np.asarray(sphere_centre, dtype=float), "midplane_section_x_m": float(xs_mid)}
+    return variables, {"coords": coords, "attrs": attrs}
+
+
 def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarray, p: Particles,
-                  sphere_x_end: float, cost: dict[str, float], max_penetration: float) -> xr.Dataset:
+                  sphere_centre: np.ndarray, cost: dict[str, float], max_penetration: float,
+                  coating_row: int = -1) -> xr.Dataset:
     """The results of one run as an xarray Dataset with units, long names and provenance."""
     mask = steady_window_mask(slid_m, scene)
     if mask.sum() < 3:
@@ -108,7 +176,7 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         raise SimulationError(f"the sphere lost contact while sliding (mean Fz = {Fz:.3g} N for load_N = "
                               f"{scene.load_N:g} N): inertia dominates; lower sliding.speed_m_s or mass_scaling")
     a_exp, _ = scene.expected_contact()
-    y, z_top, sections = residual_profiles(p, scene, sphere_x_end, a_exp)
+    y, z_top, sections = residual_profiles(p, scene, float(sphere_centre[0]), a_exp)
     near_track = np.abs(y) <= 1.5 * a_exp
     dg = float(max(-np.nanmin(z_top[near_track]), 0.0))
     hpu = float(max(np.nanmax(z_top), 0.0))
@@ -125,6 +193,11 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     )
     ds["profile_z"] = (("y",), z_top, {"units": "m", "long_name": "residual surface height, mean of the sections",
                                        "allow_missing": 1})
+    pic_vars, pic_extra = picture_variables(p, scene, sphere_centre, coating_row, a_exp, sections)
+    ds = ds.assign_coords(pic_extra["coords"])
+    for name, var in pic_vars.items():
+        ds[name] = var
+    ds.attrs.update(pic_extra["attrs"])
     ds["in_steady_window"] = (("record",), mask, {"units": "1", "long_name": "record lies in the steady window"})
     for name, value in steady.items():
         u, ln = STEADY_META[name]

@@ -32,6 +32,7 @@ class Particles:
     mat_b: np.ndarray  # (n,) int32 second material row (straddling particles)
     frac_a: np.ndarray  # (n,) volume fraction of mat_a
     near: np.ndarray  # (n,) int8: within reach of the sphere's contact nodes
+    z0: np.ndarray  # (n,) initial height, m: labels material lines (the coating interface) after deformation
 
     @property
     def n(self) -> int:
@@ -82,5 +83,5 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
     return Particles(
         x=x, v=np.zeros((n, 3)), C=np.zeros((n, 3, 3)), stress=np.zeros((n, 6)), J=np.ones(n), vol0=vol0,
         mass=mass, eps_p=np.zeros(n), temperature=np.full(n, scene.outputs.initial_temperature_K),
-        mat_a=mat_a, mat_b=mat_b, frac_a=frac_a, near=np.zeros(n, dtype=np.int8),
+        mat_a=mat_a, mat_b=mat_b, frac_a=frac_a, near=np.zeros(n, dtype=np.int8), z0=x[:, 2].copy(),
     )

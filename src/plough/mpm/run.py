@@ -106,8 +106,8 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     n = state.particles.n
     cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
             "dt_s": const.dt, "particle_steps_per_s": n * state.step / wall, "threads": numba.get_num_threads()}
-    return io.build_dataset(scene, series, slid, state.particles, state.sphere.centre[0], cost,
-                            rec.max_penetration)
+    return io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
+                            rec.max_penetration, coating_row)
 
 
 def _progress(scene: Scene, enabled: bool):
@@ -134,3 +134,23 @@ def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir:
     scene = Scene.from_yaml(Path(scene_path))
     ds = simulate(scene, progress=progress, snapshots_dir=snapshots_dir, threads=threads)
     return io.write_result(ds, output)
+
+
+def warm_up(threads: int | None = None) -> float:
+    """Compile (or load from numba's cache) every kernel by running a tiny scene; returns seconds.
+
+    Workflows call this once before fanning runs out: parallel first-time compilation of
+    ``cache=True`` functions can race on the cache files.
+    """
+    from plough.materials import rigid_plastic
+    from plough.mpm.scene import Discretisation, Domain, Layers, Outputs, Sliding
+
+    t0 = time.perf_counter()
+    scene = Scene(layers=Layers(substrate=rigid_plastic("warm_up", 900e6, coating=False),
+                                coating=rigid_plastic("warm_up_coating", 450e6, coating=True),
+                                coating_thickness_m=15e-6),
+                  load_N=0.5, domain=Domain(radius_m=100e-6, length_m=400e-6),
+                  sliding=Sliding(distance_m=150e-6), discretisation=Discretisation(particle_size_m=20e-6),
+                  outputs=Outputs(records=20), name="warm_up")
+    simulate(scene, progress=False, threads=threads)
+    return time.perf_counter() - t0

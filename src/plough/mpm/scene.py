@@ -212,6 +212,7 @@ class Outputs:
     profile_sections: int = 5
     taylor_quinney: float = 0.9
     initial_temperature_K: float = ROOM_TEMPERATURE_K
+    buried_profile_depth_m: float = 15e-6
 
     def __post_init__(self) -> None:
         lo, hi = self.steady_window
@@ -223,6 +224,8 @@ class Outputs:
             raise ValueError(f"outputs.snapshots = {self.snapshots!r} must be >= 0")
         if self.profile_sections < 1:
             raise ValueError(f"outputs.profile_sections = {self.profile_sections!r} must be >= 1")
+        if not (math.isfinite(self.buried_profile_depth_m) and self.buried_profile_depth_m > 0):
+            raise ValueError(f"outputs.buried_profile_depth_m = {self.buried_profile_depth_m!r} m must be > 0")
         if not (0 <= self.taylor_quinney <= 1):
             raise ValueError(f"outputs.taylor_quinney = {self.taylor_quinney!r} is outside [0, 1]")
 
@@ -276,20 +279,8 @@ class Scene:
 
     # -- feasibility: refuse what cannot work before running
     def expected_contact(self) -> tuple[float, float]:
-        """(contact radius a, ploughing depth dp) from the analytical model, for sizing and checks.
-
-        Hardness of each layer: 3 sigma_y at a representative plastic strain of 0.08 (Tabor),
-        static rate, room temperature.
-        """
-        from plough.analytical import ploughing
-
-        Hs = representative_hardness(self.layers.substrate)
-        Hc = representative_hardness(self.layers.coating) if self.layers.coated else Hs
-        try:
-            res = ploughing(self.load_N, self.sphere.radius_m, self.layers.coating_thickness_m, Hc, Hs, k1=125.0)
-        except ValueError:
-            return self.sphere.radius_m, self.sphere.radius_m
-        return float(res.a), float(res.dp)
+        """(contact radius a, ploughing depth dp) from the analytical model, for sizing and checks."""
+        return expected_contact(self.layers, self.load_N, self.sphere.radius_m)
 
     def _check_fits(self) -> None:
         a, dp = self.expected_contact()
@@ -304,6 +295,9 @@ class Scene:
         if self.sliding.distance_m + 4.0 * a > dom.length_m:
             raise ValueError(f"domain.length_m = {dom.length_m:g} m is too short for sliding.distance_m = "
                              f"{self.sliding.distance_m:g} m plus 2 contact diameters ({4 * a:.3g} m)")
+        if self.sliding.distance_m < 2.7 * a:
+            raise ValueError(f"sliding.distance_m = {self.sliding.distance_m:g} m is too short to leave a residual "
+                             f"groove behind the sphere: it must be >= 2.7 expected contact radii ({2.7 * a:.3g} m)")
         if h > 0.25 * dom.radius_m:
             raise ValueError(f"discretisation.particle_size_m = {h:g} m is too coarse for domain.radius_m = "
                              f"{dom.radius_m:g} m (allowed: h <= radius / 4)")
@@ -402,6 +396,50 @@ class Scene:
             raise ValueError("a scene file must hold a mapping of keys to values")
         return cls.from_dict(data)
 
+    def with_sized_domain(self, radius_contact_radii: float = 2.5, end_margin_contact_radii: float = 3.0) -> Scene:
+        """A copy whose block is sized from the expected contact radius (see :func:`sized_domain`)."""
+        dom = sized_domain(self.layers, self.load_N, self.sphere.radius_m, self.sliding.distance_m,
+                           self.discretisation.particle_size_m, self.domain.symmetric,
+                           radius_contact_radii, end_margin_contact_radii)
+        return replace(self, domain=dom)
+
     def with_(self, **changes: Any) -> Scene:
         """A copy with some top-level parts replaced (validated again)."""
         return replace(self, **changes)
+
+
+def expected_contact(layers: Layers, load_N: float, sphere_radius_m: float) -> tuple[float, float]:
+    """(contact radius a, ploughing depth dp) of the analytical model (eqs. 1-3), for sizing and checks.
+
+    Hardness of each layer: 3 sigma_y at a representative plastic strain of 0.08 (Tabor), static
+    rate, room temperature; k1 = 125.
+    """
+    from plough.analytical import ploughing
+
+    Hs = representative_hardness(layers.substrate)
+    Hc = representative_hardness(layers.coating) if layers.coated else Hs
+    try:
+        res = ploughing(load_N, sphere_radius_m, layers.coating_thickness_m, Hc, Hs, k1=125.0)
+    except ValueError:
+        return sphere_radius_m, sphere_radius_m
+    return float(res.a), float(res.dp)
+
+
+def sized_domain(layers: Layers, load_N: float, sphere_radius_m: float, slide_m: float, particle_size_m: float,
+                 symmetric: bool = True, radius_contact_radii: float = 2.5,
+                 end_margin_contact_radii: float = 3.0) -> Domain:
+    """A block sized from the expected contact radius a instead of the paper's fixed 0.2 x 1 mm.
+
+    Radius ``radius_contact_radii * a`` (at least 4 particle sizes), length the slide plus
+    ``end_margin_contact_radii * a`` before the start and after the end, both rounded up to whole
+    particle sizes. The plastic zone of a sliding sphere reaches about 2 a;
+    ``benchmarks/work_precision.py`` measures how far a larger block moves mu and dp.
+    """
+    if radius_contact_radii < 2.0 or end_margin_contact_radii < 2.0:
+        raise ValueError(f"domain sizing factors radius_contact_radii = {radius_contact_radii!r}, "
+                         f"end_margin_contact_radii = {end_margin_contact_radii!r} must be >= 2")
+    a, _ = expected_contact(layers, load_N, sphere_radius_m)
+    h = particle_size_m
+    radius = round(h * math.ceil(max(radius_contact_radii * a, 4.0 * h) / h - 1e-9), 12)
+    length = round(h * math.ceil((slide_m + 2.0 * end_margin_contact_radii * a) / h - 1e-9), 12)
+    return Domain(radius_m=radius, length_m=length, symmetric=symmetric)

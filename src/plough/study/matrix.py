@@ -1,0 +1,307 @@
+"""The MPM study matrix of studies.md: workflow config -> scenes (one per run) and figure plans.
+
+A figure is a set of *panels*; a panel is a set of *series* (curves) along one study axis
+(hardness ratio H~, coating thickness t or load); each point of a series is one physical scene,
+run at every configured particle size h and extrapolated to h -> 0. Single-run figures (pictures
+and force histories) use one scene at the finest size.
+
+Scenes are keyed by what makes them physically distinct (materials, thickness, interface, ball,
+load), so a scene shared by several figures (Figs. 11 and 13, 15 and 20, ...) is one run. The run
+id is ``<scene key>_h<h in um>``; its scene dict is complete and in SI units (materials expanded),
+so the workflow can pass it through ``params:`` and rerun exactly the runs whose physics changed.
+
+Analytical values on the same coordinates use eqs. 1-5 with each layer's hardness: H for the
+rigid-plastic studies, 3 sigma_y at a plastic strain of 0.08 (Tabor) for the real materials.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from plough.materials import interface_from_dict, representative_hardness
+from plough.mpm.scene import (
+    Discretisation,
+    Domain,
+    Layers,
+    Outputs,
+    Scene,
+    Sliding,
+    Sphere,
+    material_from_spec,
+    sized_domain,
+)
+
+#: Steady-state outputs extrapolated to h -> 0 (named as in the analytical model).
+OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration")
+#: Outputs the analytical model gives on the same coordinates.
+ANALYTICAL_OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp")
+SWEEP_FIGURES = ("fig11", "fig13", "fig15", "fig16", "fig18", "fig20", "fig21", "fig23")
+SINGLE_RUN_FIGURES = ("fig12", "fig14", "fig17", "fig19")
+MPM_FIGURES = tuple(sorted(SWEEP_FIGURES + SINGLE_RUN_FIGURES))
+
+AXES = {
+    "hardness_ratio": ("1", "coating to substrate hardness ratio H~ = Hc / Hs"),
+    "thickness_um": ("um", "coating thickness t"),
+    "load_N": ("N", "normal load Fn"),
+}
+
+
+def fmt(x: float) -> str:
+    """One spelling per value for keys and wildcards (25.0 and 25 are the same run)."""
+    return f"{float(x):g}"
+
+
+# ----------------------------------------------------------------------------- physical points
+@dataclass(frozen=True)
+class Point:
+    """One physical scene, independent of the particle size."""
+
+    key: str
+    load_N: float
+    radius_m: float
+    thickness_m: float
+    substrate: Any  # material spec: a name or {"rigid_plastic_hardness_Pa": H}
+    coating: Any | None
+    interface: dict[str, Any]
+    k1: float = field(default=125.0, compare=False)  # the analytical model's only: one run serves any k1
+
+    def layers(self) -> Layers:
+        coating = None
+        if self.thickness_m > 0:
+            coating = material_from_spec(self.coating, coating=True, where=f"{self.key}.coating")
+        return Layers(substrate=material_from_spec(self.substrate, coating=False, where=f"{self.key}.substrate"),
+                      coating=coating, coating_thickness_m=self.thickness_m)
+
+    def hardnesses_Pa(self) -> tuple[float, float]:
+        """(Hc, Hs) for the analytical model (Hc = Hs when uncoated)."""
+        lay = self.layers()
+        Hs = representative_hardness(lay.substrate)
+        return (representative_hardness(lay.coating) if lay.coated else Hs), Hs
+
+
+@dataclass(frozen=True)
+class Series:
+    label: str
+    points: tuple[Point, ...]
+
+
+@dataclass(frozen=True)
+class Panel:
+    name: str
+    series_dim: str
+    axis: str
+    values: tuple[float, ...]
+    series: tuple[Series, ...]
+
+
+def _interface_key(d: dict[str, Any]) -> str:
+    model = d["model"]
+    if model == "constant":
+        return f"const{fmt(d['H0_Pa'] / 1e6)}"
+    if model == "proportional":
+        return f"prop{fmt(d.get('f', 1.0))}"
+    return f"bl{fmt(d['Cp'])}-{fmt(d['np'])}"
+
+
+def _interface(name: str, rp: dict[str, Any]) -> dict[str, Any]:
+    if name == "constant":
+        return {"model": "constant", "H0_Pa": float(rp["H0_MPa"]) * 1e6}
+    if name == "proportional":
+        return {"model": "proportional", "f": float(rp.get("f", 1.0))}
+    raise ValueError(f"interface = {name!r} is unknown for the rigid-plastic studies; allowed: constant, proportional")
+
+
+def rigid_plastic_point(rp: dict[str, Any], ratio: float, substrate_MPa: float, thickness_um: float,
+                        interface: str, k1: float) -> Point:
+    Hs, Hc = float(substrate_MPa), float(ratio) * float(substrate_MPa)
+    iface = _interface(interface, rp)
+    t = float(thickness_um)
+    coated = f"Hc{fmt(Hc)}_Hs{fmt(Hs)}_t{fmt(t)}" if t > 0 else f"Hs{fmt(Hs)}_t0"
+    key = f"rp_{coated}_{_interface_key(iface)}_r{fmt(rp['radius_um'])}_F{fmt(rp['load_N'])}"
+    return Point(key=key, load_N=float(rp["load_N"]), radius_m=float(rp["radius_um"]) * 1e-6, thickness_m=t * 1e-6,
+                 substrate={"rigid_plastic_hardness_Pa": Hs * 1e6},
+                 coating={"rigid_plastic_hardness_Pa": Hc * 1e6} if t > 0 else None, interface=iface, k1=float(k1))
+
+
+def real_point(real: dict[str, Any], system: str, load_N: float, radius_um: float,
+               thickness_um: float | None = None) -> Point:
+    """``system``: ``coated`` (zinc coating on DX56), ``zinc_block`` or ``steel`` (DX56)."""
+    spec = real["systems"][system]
+    lub = real["lubricants"][spec["lubricant"]]
+    iface = {"model": "boundary_layer", "Cp": float(lub["Cp"]), "np": float(lub["np"])}
+    t = float(real["coating_thickness_um"] if thickness_um is None else thickness_um) if spec.get("coating") else 0.0
+    mats = f"{spec['coating']}-on-{spec['substrate']}_t{fmt(t)}" if t > 0 else spec["substrate"]
+    key = f"{mats}_{_interface_key(iface)}_r{fmt(radius_um)}_F{fmt(load_N)}"
+    return Point(key=key, load_N=float(load_N), radius_m=float(radius_um) * 1e-6, thickness_m=t * 1e-6,
+                 substrate=spec["substrate"], coating=spec.get("coating") if t > 0 else None, interface=iface,
+                 k1=float(real["k1"]))
+
+
+# ----------------------------------------------------------------------------- figures
+def figure_panels(config: dict[str, Any], figure: str) -> tuple[Panel, ...]:
+    """The panels of a sweep figure (Figs. 11, 13, 15, 16, 18, 20, 21, 23)."""
+    mpm = config["mpm"]
+    rp, real = mpm["rigid_plastic"], mpm["real_materials"]
+    if figure in ("fig11", "fig13"):
+        rs = rp["ratio_sweep"]
+        ratios = tuple(float(x) for x in rs["hardness_ratio"])
+        a = Panel("a", "interface", "hardness_ratio", ratios, tuple(
+            Series(iface, tuple(rigid_plastic_point(rp, x, rs["substrate_hardness_MPa"], rs["thickness_um"], iface,
+                                                    rs["k1"]) for x in ratios))
+            for iface in rs["interfaces"]))
+        ts = rp["thickness_sweep"]
+        thick = tuple(float(x) for x in ts["thickness_um"])
+        b = Panel("b", "coating", "thickness_um", thick, tuple(
+            Series(case, tuple(rigid_plastic_point(rp, ts[case]["hardness_ratio"], ts[case]["substrate_hardness_MPa"],
+                                                   t, ts["interface"], ts["k1"]) for t in thick))
+            for case in ("soft", "hard")))
+        return (a, b)
+    loads = tuple(float(x) for x in real["loads_N"])
+    r1, r3 = (float(x) for x in real["ball_radii_um"])
+
+    def vs_load(system: str, radius_um: float, label: str) -> Series:
+        return Series(label, tuple(real_point(real, system, f, radius_um) for f in loads))
+
+    if figure in ("fig15", "fig20"):
+        return (Panel("", "material", "load_N", loads,
+                      (vs_load("zinc_block", r1, "zinc_block"), vs_load("steel", r1, "steel"))),)
+    if figure in ("fig16", "fig21"):
+        return (Panel("", "ball", "load_N", loads,
+                      (vs_load("coated", r1, f"r{fmt(r1)}um"), vs_load("coated", r3, f"r{fmt(r3)}um"))),)
+    if figure == "fig23":
+        return (Panel("", "material", "load_N", loads,
+                      tuple(vs_load(s, r1, s) for s in ("coated", "zinc_block", "steel"))),)
+    if figure == "fig18":
+        ts = real["thickness_sweep"]
+        thick = tuple(float(x) for x in ts["thickness_um"])
+        coated = Series("coated", tuple(real_point(real, "coated", ts["load_N"], ts["radius_um"], t) for t in thick))
+        bulk = Series("zinc_block", (real_point(real, "zinc_block", ts["load_N"], ts["radius_um"]),))
+        return (Panel("t", "coated_system", "thickness_um", thick, (coated,)),
+                Panel("bulk", "block", "load_N", (float(ts["load_N"]),), (bulk,)))
+    raise ValueError(f"figure = {figure!r} is not a sweep figure; sweep figures: {SWEEP_FIGURES}")
+
+
+def figure_points(config: dict[str, Any], figure: str) -> dict[str, Point]:
+    """Cases of a single-run figure (Figs. 12, 14, 17, 19): case label -> point."""
+    mpm = config["mpm"]
+    rp, real = mpm["rigid_plastic"], mpm["real_materials"]
+    if figure == "fig12":
+        pic = rp["picture"]
+        return {"coated": rigid_plastic_point(rp, pic["hardness_ratio"], pic["substrate_hardness_MPa"],
+                                              pic["thickness_um"], pic["interface"], rp["ratio_sweep"]["k1"])}
+    pic = real["picture"]
+    coated = real_point(real, "coated", pic["load_N"], pic["radius_um"])
+    if figure in ("fig14", "fig19"):
+        return {"coated": coated}
+    if figure == "fig17":
+        return {"coated": coated, "zinc_block": real_point(real, "zinc_block", pic["load_N"], pic["radius_um"])}
+    raise ValueError(f"figure = {figure!r} is not a single-run figure; single-run figures: {SINGLE_RUN_FIGURES}")
+
+
+def particle_sizes_um(config: dict[str, Any]) -> tuple[float, ...]:
+    return tuple(sorted((float(h) for h in config["mpm"]["particle_sizes_um"]), reverse=True))
+
+
+def run_id(point: Point, h_um: float) -> str:
+    return f"{point.key}_h{fmt(h_um)}"
+
+
+def figure_runs(config: dict[str, Any], figure: str) -> list[str]:
+    """Run ids a figure needs: every size of every sweep point, the finest size for pictures."""
+    if figure in SINGLE_RUN_FIGURES:
+        h = particle_sizes_um(config)[-1]
+        return [run_id(p, h) for p in figure_points(config, figure).values()]
+    if figure == "fig22":  # the MPM points of Fig. 21 beside the power-law fits
+        return figure_runs(config, "fig21")
+    if figure not in SWEEP_FIGURES:
+        return []
+    return [run_id(p, h) for panel in figure_panels(config, figure) for s in panel.series for p in s.points
+            for h in particle_sizes_um(config)]
+
+
+# ----------------------------------------------------------------------------- scenes
+def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
+    """The complete scene of one run: the physical point at particle size h with the numerics."""
+    h = float(h_um) * 1e-6
+    slide = float(numerics["sliding_distance_um"]) * 1e-6
+    layers = point.layers()
+    dom = numerics["domain"]
+    symmetric = bool(numerics.get("symmetric", True))
+    if dom["mode"] == "sized":
+        domain = sized_domain(layers, point.load_N, point.radius_m, slide, h, symmetric,
+                              float(dom["radius_contact_radii"]), float(dom["end_margin_contact_radii"]))
+    else:
+        domain = Domain(radius_m=float(dom["radius_um"]) * 1e-6, length_m=float(dom["length_um"]) * 1e-6,
+                         symmetric=symmetric)
+    return Scene(
+        layers=layers, load_N=point.load_N, sphere=Sphere(radius_m=point.radius_m),
+        interface=interface_from_dict(point.interface), domain=domain,
+        sliding=Sliding(distance_m=slide, speed_m_s=float(numerics["speed_m_s"]),
+                        experiment_speed_m_s=float(numerics["experiment_speed_m_s"])),
+        discretisation=Discretisation(particle_size_m=h, particles_per_cell=int(numerics["particles_per_cell"]),
+                                      cfl=float(numerics["cfl"]), mass_scaling=float(numerics["mass_scaling"])),
+        outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
+                        records=int(numerics["records"]),
+                        buried_profile_depth_m=float(numerics["buried_profile_depth_um"]) * 1e-6),
+        name=run_id(point, h_um),
+    )
+
+
+def all_points(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> dict[str, Point]:
+    """Every distinct physical point of the given figures; the same key must mean the same point."""
+    points: dict[str, Point] = {}
+
+    def add(p: Point) -> None:
+        if p.key in points and points[p.key] != p:
+            raise ValueError(f"two different scenes share the key {p.key!r}: {points[p.key]} and {p}")
+        points[p.key] = p
+
+    for fig in figures:
+        if fig in SINGLE_RUN_FIGURES:
+            for p in figure_points(config, fig).values():
+                add(p)
+        else:
+            for panel in figure_panels(config, fig):
+                for s in panel.series:
+                    for p in s.points:
+                        add(p)
+    return points
+
+
+def all_runs(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> dict[str, dict[str, Any]]:
+    """run id -> complete scene dict (SI, JSON-serialisable) for every run the figures need."""
+    points = all_points(config, figures)
+    numerics = config["mpm"]["numerics"]
+    wanted = {rid for fig in figures for rid in figure_runs(config, fig)}
+    runs: dict[str, dict[str, Any]] = {}
+    for p in points.values():
+        for h in particle_sizes_um(config):
+            rid = run_id(p, h)
+            if rid in wanted:
+                runs[rid] = scene_for(p, h, numerics).to_dict()
+    return dict(sorted(runs.items()))
+
+
+def analytical_values(point: Point, correction: str = "none") -> dict[str, float]:
+    """The analytical model (eqs. 1-5) at a point: mu, mu_pl, mu_sh, dp."""
+    from plough.analytical import ploughing
+
+    Hc, Hs = point.hardnesses_Pa()
+    iface = point.interface
+    kw: dict[str, Any] = {"interface": iface["model"]}
+    if iface["model"] == "constant":
+        kw["H0_Pa"] = iface["H0_Pa"]
+    elif iface["model"] == "proportional":
+        kw["f"] = iface.get("f", 1.0)
+    else:
+        kw["Cp"], kw["np_exponent"] = iface["Cp"], iface["np"]
+    try:
+        res = ploughing(point.load_N, point.radius_m, point.thickness_m, Hc, Hs, k1=point.k1,
+                        correction=correction, **kw)
+    except ValueError:
+        return {k: float("nan") for k in ANALYTICAL_OUTPUTS}
+    return {k: float(np.asarray(getattr(res, k))) for k in ANALYTICAL_OUTPUTS}
+

@@ -1,0 +1,187 @@
+"""Datasets behind the MPM figures of studies.md (Figs. 11-21, 23 and the MPM points of Fig. 22).
+
+Sweep figures: for every panel, each output of :data:`plough.study.matrix.OUTPUTS` per particle
+size (dims ``series, axis, h``), its extrapolation to h -> 0 (Richardson with the observed order and
+Roache's GCI, least-squares fallback flagged; :mod:`plough.study.extrapolation`) as
+``<output>_h0``, ``<output>_h0_uncertainty``, ``<output>_h0_order``, ``<output>_h0_method``,
+``<output>_h0_flagged``, and the analytical model (eqs. 1-5) on the same coordinates as
+``<output>_analytical``. A figure with two panels suffixes its variables with the panel name
+(``dp_a``, ``dp_b``). Single-run figures keep the force histories, profiles and particle pictures
+of the finest run of each case, along a ``case`` dimension.
+
+Coordinates are the config's values (never float arithmetic), so datasets align exactly.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from plough.io import provenance_attrs
+from plough.mpm.io import STEADY_META
+from plough.study import matrix
+from plough.study.extrapolation import extrapolate_dataarray
+
+TITLES = {
+    "fig11": "Fig. 11 - ploughing depth dp, MPM vs analytical, rigid-plastic coating",
+    "fig12": "Fig. 12 - soft coating piling up ahead of the sphere, and the forces while sliding",
+    "fig13": "Fig. 13 - friction coefficient mu, MPM vs analytical, rigid-plastic coating",
+    "fig14": "Fig. 14 - zinc-coated steel ploughed by a ball: height map, residual cross-section, materials",
+    "fig15": "Fig. 15 - ploughing depth vs load, zinc block and DX56 steel",
+    "fig16": "Fig. 16 - ploughing depth vs load, zinc-coated steel, two ball sizes",
+    "fig17": "Fig. 17 - residual cross-sections at the surface and at depth, coated steel vs zinc block",
+    "fig18": "Fig. 18b - ploughing depth vs coating thickness, zinc-coated steel and bulk zinc",
+    "fig19": "Fig. 19 - forces vs sliding distance, zinc-coated steel",
+    "fig20": "Fig. 20 - friction coefficient vs load, zinc block and DX56 steel",
+    "fig21": "Fig. 21 - friction coefficient vs load, zinc-coated steel, two ball sizes",
+    "fig23": "Fig. 23a - friction coefficient vs load: coated steel, zinc block and DX56 steel",
+}
+
+#: What the single-run figures draw of their run(s).
+SINGLE_RUN_VARIABLES = {
+    "fig12": ("Fx", "Fz", "Fx_pl", "Fx_sh", "depth", "in_steady_window", "midplane_x", "midplane_z",
+              "midplane_coating", "midplane_eps_p", "profile_z"),
+    "fig14": ("height_map", "profile_z", "section_y", "section_z", "section_coating", "section_eps_p"),
+    "fig17": ("profile_z", "buried_profile_z"),
+    "fig19": ("Fx", "Fz", "Fx_pl", "Fx_sh", "depth", "in_steady_window"),
+}
+
+
+def load_runs(run_ids: list[str], paths: Mapping[str, str | Path]) -> dict[str, xr.Dataset]:
+    """Load the result file of every run; a missing run is an error naming it (never an empty plot)."""
+    out = {}
+    for rid in run_ids:
+        if rid not in paths or not Path(paths[rid]).exists():
+            raise FileNotFoundError(f"the result of run {rid!r} is missing ({paths.get(rid)}); run it first")
+        out[rid] = xr.load_dataset(paths[rid])
+    return out
+
+
+def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mapping[str, xr.Dataset],
+                   suffix: str) -> xr.Dataset:
+    labels = [s.label for s in panel.series]
+    ax_units, ax_long = matrix.AXES[panel.axis]
+    coords = {
+        panel.series_dim: ((panel.series_dim,), labels, {"long_name": panel.series_dim.replace("_", " ")}),
+        panel.axis: ((panel.axis,), np.asarray(panel.values, dtype=float), {"units": ax_units, "long_name": ax_long}),
+        "h": (("h",), np.asarray(sizes_um, dtype=float), {"units": "um", "long_name": "particle size h"}),
+    }
+    shape = (len(labels), len(panel.values), len(sizes_um))
+    per_size = {o: np.full(shape, np.nan) for o in (*matrix.OUTPUTS, "Fz_mean", "max_particle_penetration")}
+    wall = np.full(shape, np.nan)
+    analytical = {o: np.full(shape[:2], np.nan) for o in matrix.ANALYTICAL_OUTPUTS}
+    for i, series in enumerate(panel.series):
+        for j, point in enumerate(series.points):
+            for k, h in enumerate(sizes_um):
+                ds = runs[matrix.run_id(point, h)]
+                for o in per_size:
+                    per_size[o][i, j, k] = float(ds[o])
+                wall[i, j, k] = float(ds.attrs["cost_wall_time_s"])
+            for o, v in matrix.analytical_values(point).items():
+                analytical[o][i, j] = v
+    dims3 = (panel.series_dim, panel.axis, "h")
+    out = xr.Dataset(coords=coords)
+    for o, values in per_size.items():
+        units, long_name = STEADY_META[o]
+        da = xr.DataArray(values, dims=dims3, coords=coords, name=o,
+                          attrs={"units": units, "long_name": f"{long_name} (MPM, per particle size)"})
+        out[o + suffix] = da
+        if o not in matrix.OUTPUTS:
+            continue
+        ex = extrapolate_dataarray(da, "h")
+        for field in ("value", "uncertainty", "order", "method", "flagged"):
+            name = f"{o}_h0{suffix}" if field == "value" else f"{o}_h0_{field}{suffix}"
+            var = ex[field]
+            if var.dtype == bool:
+                var = var.astype(np.int8)
+            if field == "order":
+                var.attrs["allow_missing"] = 1  # NaN: undefined order of an exactly converged point
+            out[name] = var
+    for o, values in analytical.items():
+        units, long_name = STEADY_META[o]
+        out[f"{o}_analytical{suffix}"] = ((panel.series_dim, panel.axis), values,
+                                          {"units": units, "long_name": f"{long_name} (analytical model, eqs. 1-5)",
+                                           "allow_missing": 1})
+    out[f"wall_time_s{suffix}"] = (dims3, wall, {"units": "s", "long_name": "wall time of the run"})
+    return out
+
+
+def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
+    panels = matrix.figure_panels(config, figure)
+    sizes = matrix.particle_sizes_um(config)
+    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "") for p in panels]
+    ds = xr.merge(parts, combine_attrs="drop_conflicts", join="exact")
+    ds.attrs["panels"] = ",".join(p.name for p in panels)
+    if figure in ("fig11", "fig13"):
+        ds.attrs["ratio_sweep_thickness_um"] = float(config["mpm"]["rigid_plastic"]["ratio_sweep"]["thickness_um"])
+    return ds
+
+
+def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
+    cases = matrix.figure_points(config, figure)
+    h = matrix.particle_sizes_um(config)[-1]
+    keep = SINGLE_RUN_VARIABLES[figure]
+    parts = []
+    for label, point in cases.items():
+        run = runs[matrix.run_id(point, h)]
+        sub = run[[v for v in keep if v in run]]
+        for o in (*matrix.OUTPUTS, "Fz_mean"):
+            sub[o] = run[o]
+        for o, v in matrix.analytical_values(point).items():
+            units, long_name = STEADY_META[o]
+            sub[f"{o}_analytical"] = ((), v, {"units": units, "long_name": f"{long_name} (analytical model)"})
+        sub = sub.drop_vars([c for c in ("hx", "hy") if c in sub.coords and "height_map" not in keep])
+        sub.attrs = {"scene_" + label: run.attrs["scene"], "coating_representation_" + label:
+                     run.attrs["coating_representation"]}
+        parts.append(sub.expand_dims(case=[label]))
+    ds = xr.concat(parts, dim="case", join="outer", data_vars="all", coords="different",
+                   compat="equals", combine_attrs="drop_conflicts")
+    if len(parts) > 1:
+        for name in ds.data_vars:
+            ds[name].attrs["allow_missing"] = 1  # cases of different size are padded with NaN
+    ds["case"].attrs["long_name"] = "case"
+    ds.attrs["particle_size_um"] = h
+    return ds
+
+
+def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
+    """The MPM friction of Fig. 21 (h -> 0) on the coordinates Fig. 22's plot expects."""
+    fig21 = sweep_dataset(config, "fig21", runs)
+    radii = [float(x) for x in config["mpm"]["real_materials"]["ball_radii_um"]]
+    diam = np.array([2.0 * r / 1000.0 for r in radii])
+    mu = fig21["mu_h0"].values
+    unc = fig21["mu_h0_uncertainty"].values
+    coords = {"ball_diameter_mm": ("ball_diameter_mm", diam, {"units": "mm", "long_name": "ball diameter"}),
+              "mpm_load_N": ("mpm_load_N", fig21["load_N"].values, {"units": "N", "long_name": "normal load (MPM)"})}
+    return xr.Dataset({
+        "mu_mpm": (("ball_diameter_mm", "mpm_load_N"), mu,
+                   {"units": "1", "long_name": "friction coefficient, MPM extrapolated to h -> 0"}),
+        "mu_mpm_uncertainty": (("ball_diameter_mm", "mpm_load_N"), unc,
+                               {"units": "1", "long_name": "uncertainty of the MPM friction coefficient"}),
+    }, coords=coords)
+
+
+def build_dataset(config: dict[str, Any], figure: str, paths: Mapping[str, str | Path]) -> xr.Dataset:
+    """The dataset of one MPM figure from its run result files (run id -> path)."""
+    runs = load_runs(matrix.figure_runs(config, figure), paths)
+    if figure == "fig22":
+        from plough.study.analytical_figures import fig22_dataset
+
+        ds = xr.merge([fig22_dataset(config["power_law"]), fig22_mpm_points(config, runs)],
+                      combine_attrs="override")
+        ds.attrs.update(provenance_attrs(config))
+        return ds
+    if figure in matrix.SINGLE_RUN_FIGURES:
+        ds = single_run_dataset(config, figure, runs)
+    elif figure in matrix.SWEEP_FIGURES:
+        ds = sweep_dataset(config, figure, runs)
+    else:
+        raise ValueError(f"figure = {figure!r} is not an MPM figure; allowed: {matrix.MPM_FIGURES}")
+    scene_attrs = {k: v for k, v in ds.attrs.items() if k.startswith(("scene_", "coating_representation_"))}
+    ds.attrs = {**ds.attrs, **provenance_attrs(config["mpm"]), **scene_attrs}
+    ds.attrs.update(figure=figure, title=TITLES[figure])
+    return ds

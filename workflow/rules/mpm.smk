@@ -1,0 +1,70 @@
+# MPM runs (one per job, cached by file), their extrapolation to h -> 0, and the figure datasets.
+from plough.study import matrix
+
+MPM_RUNS = matrix.all_runs(config)
+MPM_THREADS = int(config["mpm"]["threads"])
+
+
+def runs_of(figure):
+    return {rid: f"results/runs/{rid}.nc" for rid in matrix.figure_runs(config, figure)}
+
+
+# numba compiles its kernels into __pycache__ on first use; parallel first compilations of
+# cache=True functions can race, so one small scene compiles them before the runs fan out.
+rule numba_warmup:
+    input:
+        PACKAGE_SOURCES,
+    output:
+        touch("results/.numba_warm"),
+    log:
+        "logs/numba_warmup.log",
+    conda:
+        "../envs/plough.yaml"
+    script:
+        "../scripts/numba_warmup.py"
+
+
+# The whole scene (materials expanded, SI) is the job's params: changing one material parameter
+# reruns exactly the runs that use it. The package source is an input for the same reason.
+rule mpm_run:
+    input:
+        PACKAGE_SOURCES,
+        warm="results/.numba_warm",
+    output:
+        "results/runs/{run}.nc",
+    params:
+        scene=lambda wc: MPM_RUNS[wc.run],
+    wildcard_constraints:
+        run="|".join(re.escape(r) for r in MPM_RUNS) if MPM_RUNS else "NO_RUNS",
+    threads: MPM_THREADS
+    resources:
+        mem_mb=4000,
+        runtime=600,
+    log:
+        "logs/runs/{run}.log",
+    benchmark:
+        "benchmarks/runs/{run}.tsv"
+    conda:
+        "../envs/plough.yaml"
+    script:
+        "../scripts/mpm_run.py"
+
+
+rule mpm_dataset:
+    input:
+        PACKAGE_SOURCES,
+        runs=lambda wc: list(runs_of(wc.figure).values()),
+    output:
+        "results/datasets/{figure}.nc",
+    params:
+        mpm=config["mpm"],
+        power_law=lambda wc: config["power_law"] if wc.figure == "fig22" else None,
+        runs=lambda wc: runs_of(wc.figure),
+    wildcard_constraints:
+        figure="|".join(MPM_DATASET_FIGURES),
+    log:
+        "logs/datasets/{figure}.log",
+    conda:
+        "../envs/plough.yaml"
+    script:
+        "../scripts/mpm_dataset.py"
