@@ -1,0 +1,328 @@
+"""Tests of plough.study.matrix: workflow config -> physical points, run ids, scenes and figure plans.
+
+Expected run counts are computed here from the config lists, independently of the module: a run is
+a physically distinct scene (materials, thickness, interface, ball, load) at one particle size.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from pathlib import Path
+
+import pytest
+import yaml
+
+from plough.analytical import ploughing
+from plough.materials import get_material, representative_hardness
+from plough.mpm.scene import Scene
+from plough.study import matrix
+
+ROOT = Path(__file__).resolve().parents[2]
+CONFIGS = {name: yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text()) for name in ("config", "smoke")}
+
+
+@pytest.fixture(params=sorted(CONFIGS), scope="module")
+def config_name(request):
+    return request.param
+
+
+@pytest.fixture(scope="module")
+def config(config_name):
+    return copy.deepcopy(CONFIGS[config_name])
+
+
+@pytest.fixture(scope="module")
+def runs(config):
+    return matrix.all_runs(config)
+
+
+# ----------------------------------------------------------------------------- independent expectation
+def _r(x: float) -> float:
+    return round(float(x), 9)
+
+
+def expected_points(config: dict) -> tuple[set, set]:
+    """(sweep points, single-run points) as physical tuples, straight from the config lists.
+
+    Rigid plastic: ("rp", Hc, Hs, t, interface, radius, load) with Hc = None when uncoated.
+    Real materials: ("real", system, t, radius, load) with t = 0 for the uncoated systems.
+    """
+    mpm = config["mpm"]
+    rp, real = mpm["rigid_plastic"], mpm["real_materials"]
+
+    def iface(name):
+        return ("constant", _r(rp["H0_MPa"])) if name == "constant" else ("proportional", _r(rp.get("f", 1.0)))
+
+    def rp_point(ratio, hs, t, name):
+        t = _r(t)
+        return ("rp", _r(ratio * hs) if t > 0 else None, _r(hs), t, iface(name), _r(rp["radius_um"]),
+                _r(rp["load_N"]))
+
+    def real_pt(system, radius, load, t=None):
+        coated = "coating" in real["systems"][system]
+        thick = _r(real["coating_thickness_um"] if t is None else t) if coated else 0.0
+        return ("real", system, thick, _r(radius), _r(load))
+
+    sweep = set()
+    rs = rp["ratio_sweep"]
+    sweep |= {rp_point(x, rs["substrate_hardness_MPa"], rs["thickness_um"], i)
+              for x in rs["hardness_ratio"] for i in rs["interfaces"]}
+    ts = rp["thickness_sweep"]
+    sweep |= {rp_point(ts[case]["hardness_ratio"], ts[case]["substrate_hardness_MPa"], t, ts["interface"])
+              for case in ("soft", "hard") for t in ts["thickness_um"]}
+    r1, r3 = real["ball_radii_um"]
+    for load in real["loads_N"]:
+        sweep |= {real_pt("zinc_block", r1, load), real_pt("steel", r1, load),  # Figs. 15, 20, 23
+                  real_pt("coated", r1, load), real_pt("coated", r3, load)}  # Figs. 16, 21, 23
+    rts = real["thickness_sweep"]  # Fig. 18
+    sweep |= {real_pt("coated", rts["radius_um"], rts["load_N"], t) for t in rts["thickness_um"]}
+    sweep.add(real_pt("zinc_block", rts["radius_um"], rts["load_N"]))
+
+    pic, rpic = rp["picture"], real["picture"]
+    single = {rp_point(pic["hardness_ratio"], pic["substrate_hardness_MPa"], pic["thickness_um"], pic["interface"]),
+              real_pt("coated", rpic["radius_um"], rpic["load_N"]),
+              real_pt("zinc_block", rpic["radius_um"], rpic["load_N"])}
+    return sweep, single
+
+
+def _floats(obj):
+    """Every number of a config as a float (25 -> 25.0), keeping bools and strings."""
+    if isinstance(obj, dict):
+        return {k: _floats(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_floats(v) for v in obj]
+    if isinstance(obj, int) and not isinstance(obj, bool):
+        return float(obj)
+    return obj
+
+
+# ----------------------------------------------------------------------------- run ids and scenes
+def test_every_run_is_a_valid_scene_named_by_its_id(config, runs):
+    sizes = {matrix.fmt(h): float(h) for h in config["mpm"]["particle_sizes_um"]}
+    assert runs
+    for rid, d in runs.items():
+        scene = Scene.from_dict(d)
+        assert scene.name == rid == d["name"]
+        suffix = re.fullmatch(r".+_h([0-9.e+-]+)", rid).group(1)
+        assert suffix in sizes, rid
+        assert scene.discretisation.particle_size_m == pytest.approx(sizes[suffix] * 1e-6, rel=1e-12), rid
+        # the dict is complete: it survives the round trip through the Scene unchanged
+        assert scene.to_dict() == d, rid
+
+
+def test_run_count_is_distinct_points_times_sizes_plus_finest_pictures(config, config_name, runs):
+    sweep, single = expected_points(config)
+    n_sizes = len(set(config["mpm"]["particle_sizes_um"]))
+    expected = len(sweep) * n_sizes + len(single - sweep)
+    assert len(runs) == expected
+    assert len(matrix.all_points(config)) == len(sweep | single)
+    if config_name == "config":
+        # spelled out for the full matrix: rigid plastic 7 ratios x 2 interfaces + 11 thicknesses x 2 cases,
+        # less the hard t = 25 um proportional point that is also in the ratio sweep (Figs. 11/13 share runs);
+        # real materials: zinc block + steel (Figs. 15/20) and the coated steel with two balls (Figs. 16/21),
+        # each at 7 loads, plus 5 coating thicknesses of Fig. 18 less the t = 15 um one of Fig. 16 (its
+        # bulk zinc point is Fig. 15's at 22 N); every picture point (Figs. 12, 14, 17, 19) is a sweep point.
+        assert len(sweep) == (7 * 2 + 11 * 2 - 1) + (2 * 7 + 2 * 7 + 5 - 1) == 67
+        assert single <= sweep
+        assert len(runs) == 67 * 3 == 201
+
+
+def test_runs_are_the_union_of_the_figures_runs(config, runs):
+    union = {rid for fig in (*matrix.MPM_FIGURES, "fig22") for rid in matrix.figure_runs(config, fig)}
+    assert set(runs) == union
+
+
+def test_shared_figures_share_runs(config):
+    runs_of = {fig: matrix.figure_runs(config, fig) for fig in (*matrix.MPM_FIGURES, "fig22")}
+    assert runs_of["fig22"] == runs_of["fig21"]
+    assert runs_of["fig11"] == runs_of["fig13"]
+    assert runs_of["fig15"] == runs_of["fig20"]
+    assert runs_of["fig16"] == runs_of["fig21"]
+    # Fig. 18's point at the standard coating thickness is Fig. 16's run at that load and ball
+    real = config["mpm"]["real_materials"]
+    t0 = matrix.fmt(real["coating_thickness_um"])
+    fig18_std = {r for r in runs_of["fig18"] if f"_t{t0}_" in r}
+    assert len(fig18_std) == len(config["mpm"]["particle_sizes_um"])
+    assert fig18_std <= set(runs_of["fig16"])
+    # Fig. 23 is made of Fig. 15's and Fig. 16's runs only
+    assert set(runs_of["fig23"]) <= set(runs_of["fig15"]) | set(runs_of["fig16"])
+
+
+def test_sweep_points_at_every_size_pictures_at_the_finest(config):
+    sizes = matrix.particle_sizes_um(config)
+    assert list(sizes) == sorted((float(h) for h in config["mpm"]["particle_sizes_um"]), reverse=True)
+    finest = matrix.fmt(min(float(h) for h in config["mpm"]["particle_sizes_um"]))
+    for fig in matrix.SINGLE_RUN_FIGURES:
+        ids = matrix.figure_runs(config, fig)
+        assert ids and all(r.endswith(f"_h{finest}") for r in ids), fig
+    for fig in matrix.SWEEP_FIGURES:
+        ids = matrix.figure_runs(config, fig)
+        n_points = sum(len(s.points) for p in matrix.figure_panels(config, fig) for s in p.series)
+        assert len(ids) == n_points * len(sizes), fig
+        for h in sizes:
+            assert sum(r.endswith(f"_h{matrix.fmt(h)}") for r in ids) == n_points, (fig, h)
+
+
+def test_a_picture_off_the_sweeps_adds_one_run_at_the_finest_size():
+    config = copy.deepcopy(CONFIGS["smoke"])
+    before = matrix.all_runs(config)
+    config["mpm"]["rigid_plastic"]["picture"]["hardness_ratio"] = 0.3  # in no ratio sweep
+    after = matrix.all_runs(config)
+    new = set(after) - set(before)
+    assert set(before) <= set(after)
+    finest = matrix.fmt(min(config["mpm"]["particle_sizes_um"]))
+    assert len(new) == 1
+    (rid,) = new
+    assert rid.endswith(f"_h{finest}")
+    assert matrix.figure_runs(config, "fig12") == [rid]
+    scene = Scene.from_dict(after[rid])
+    hc, hs = (representative_hardness(m) for m in (scene.layers.coating, scene.layers.substrate))
+    assert hc / hs == pytest.approx(0.3)
+
+
+# ----------------------------------------------------------------------------- what changes a run
+def _steel_runs(runs: dict) -> set[str]:
+    return {rid for rid, d in runs.items() if d["layers"]["substrate"]["name"] == "dx56" and d["layers"]["coating"]
+            is None}
+
+
+@pytest.mark.parametrize(("path", "value", "affected"), [
+    (("real_materials", "lubricants", "dx56", "Cp"), 1.5, "steel"),
+    (("real_materials", "lubricants", "zinc", "np"), 0.9, "zinc"),
+    (("rigid_plastic", "H0_MPa"), 400, "constant"),
+], ids=["lubricant_dx56_Cp", "lubricant_zinc_np", "H0_MPa"])
+def test_changing_a_parameter_changes_exactly_the_runs_that_use_it(config, runs, path, value, affected):
+    changed_config = copy.deepcopy(config)
+    node = changed_config["mpm"]
+    for key in path[:-1]:
+        node = node[key]
+    node[path[-1]] = value
+    after = matrix.all_runs(changed_config)
+
+    if affected == "steel":
+        users = _steel_runs(runs)
+    elif affected == "zinc":  # every run with the zinc lubricant: coated steel and the zinc block
+        zinc = config["mpm"]["real_materials"]["lubricants"]["zinc"]
+        users = {rid for rid, d in runs.items()
+                 if d["interface"] == {"model": "boundary_layer", "Cp": zinc["Cp"], "np": zinc["np"]}}
+    else:
+        users = {rid for rid, d in runs.items() if d["interface"]["model"] == "constant"}
+    assert users and len(users) < len(runs)
+
+    unchanged = {rid for rid in runs if rid in after and after[rid] == runs[rid]}
+    assert set(runs) - unchanged == users
+    # the others are the same runs with the new parameter, under new ids (the key spells the interface)
+    new = set(after) - set(runs)
+    assert len(new) == len(users) and len(after) == len(runs)
+    field = {"Cp": "Cp", "np": "np", "H0_MPa": "H0_Pa"}[path[-1]]
+    scale = 1e6 if field == "H0_Pa" else 1.0
+    by_rest = {}
+    for rid in users:
+        d = copy.deepcopy(runs[rid])
+        d.pop("name")
+        d["interface"][field] = value * scale
+        by_rest[repr(d)] = rid
+    for rid in new:
+        d = copy.deepcopy(after[rid])
+        d.pop("name")
+        assert repr(d) in by_rest, rid  # nothing but the parameter differs
+
+
+def test_k1_changes_no_run_but_the_analytical_values(config, runs):
+    changed = copy.deepcopy(config)
+    rp, real = changed["mpm"]["rigid_plastic"], changed["mpm"]["real_materials"]
+    rp["ratio_sweep"]["k1"] = 60.0
+    rp["thickness_sweep"]["k1"] = 30.0
+    real["k1"] = 250.0
+    assert matrix.all_runs(changed) == runs
+    for fig in ("fig11", "fig16"):
+        old = matrix.figure_panels(config, fig)[-1].series[0].points[-1]
+        new = matrix.figure_panels(changed, fig)[-1].series[0].points[-1]
+        assert old == new  # the same physical point ...
+        assert matrix.analytical_values(old)["mu"] != pytest.approx(matrix.analytical_values(new)["mu"], rel=1e-6)
+
+
+def test_fmt_spells_a_value_one_way(config, runs):
+    assert matrix.fmt(25.0) == matrix.fmt(25) == "25"
+    assert matrix.fmt(2.5) == "2.5"
+    assert matrix.fmt(0.5) == matrix.fmt("0.5") == "0.5"
+    # a config with every number written as a float is the same set of runs
+    assert matrix.all_runs(_floats(config)) == runs
+
+
+# ----------------------------------------------------------------------------- domains and analytical values
+def test_sized_domains_cover_the_contact_in_whole_particles(config, runs):
+    dom = config["mpm"]["numerics"]["domain"]
+    assert dom["mode"] == "sized"
+    k_r, k_end = float(dom["radius_contact_radii"]), float(dom["end_margin_contact_radii"])
+    slide = float(config["mpm"]["numerics"]["sliding_distance_um"]) * 1e-6
+    for rid, d in runs.items():
+        scene = Scene.from_dict(d)
+        a, _ = scene.expected_contact()
+        h = scene.discretisation.particle_size_m
+        radius, length = scene.domain.radius_m, scene.domain.length_m
+        assert radius >= k_r * a * (1 - 1e-12), rid
+        assert radius >= 4 * h * (1 - 1e-12), rid
+        assert radius < max(k_r * a, 4 * h) + h, rid  # rounded up to the next whole particle, no further
+        assert length >= slide + 2 * k_end * a - 1e-15, rid
+        assert length < slide + 2 * k_end * a + h, rid
+        for x in (radius, length):
+            assert abs(x / h - round(x / h)) < 1e-6, (rid, x, h)
+        assert scene.domain.symmetric is bool(config["mpm"]["numerics"]["symmetric"])
+
+
+def test_analytical_values_of_rigid_plastic_points_are_the_model(config):
+    rp = config["mpm"]["rigid_plastic"]
+    rs, ts = rp["ratio_sweep"], rp["thickness_sweep"]
+    a, b = matrix.figure_panels(config, "fig11")
+    ratio = float(rs["hardness_ratio"][-1])
+    point_a = a.series[rs["interfaces"].index("constant")].points[-1]
+    hs = float(rs["substrate_hardness_MPa"]) * 1e6
+    direct_a = ploughing(float(rp["load_N"]), float(rp["radius_um"]) * 1e-6, float(rs["thickness_um"]) * 1e-6,
+                         ratio * hs, hs, k1=float(rs["k1"]), interface="constant",
+                         H0_Pa=float(rp["H0_MPa"]) * 1e6)
+    soft = ts["soft"]
+    t = float(ts["thickness_um"][-1])
+    point_b = b.series[0].points[-1]
+    assert b.series[0].label == "soft"
+    hs_b = float(soft["substrate_hardness_MPa"]) * 1e6
+    direct_b = ploughing(float(rp["load_N"]), float(rp["radius_um"]) * 1e-6, t * 1e-6,
+                         float(soft["hardness_ratio"]) * hs_b, hs_b, k1=float(ts["k1"]), interface="proportional",
+                         f=1.0)
+    for point, direct in ((point_a, direct_a), (point_b, direct_b)):
+        values = matrix.analytical_values(point)
+        assert set(values) == set(matrix.ANALYTICAL_OUTPUTS)
+        for name, v in values.items():
+            assert math.isfinite(v)
+            assert v == pytest.approx(float(getattr(direct, name)), rel=1e-9), (point.key, name)
+    # the correction is passed through
+    once = matrix.analytical_values(point_a, correction="once")
+    direct_once = ploughing(float(rp["load_N"]), float(rp["radius_um"]) * 1e-6, float(rs["thickness_um"]) * 1e-6,
+                            ratio * hs, hs, k1=float(rs["k1"]), interface="constant",
+                            H0_Pa=float(rp["H0_MPa"]) * 1e6, correction="once")
+    assert once["mu"] == pytest.approx(float(direct_once.mu), rel=1e-9)
+
+
+def test_analytical_values_of_real_materials_use_tabor_hardness(config):
+    real = config["mpm"]["real_materials"]
+    load, radius = float(real["loads_N"][-1]), float(real["ball_radii_um"][0])
+    point = matrix.real_point(real, "coated", load, radius)
+    lub = real["lubricants"][real["systems"]["coated"]["lubricant"]]
+    direct = ploughing(load, radius * 1e-6, float(real["coating_thickness_um"]) * 1e-6,
+                       representative_hardness(get_material("zinc_coating")),
+                       representative_hardness(get_material("dx56")), k1=float(real["k1"]),
+                       interface="boundary_layer", Cp=float(lub["Cp"]), np_exponent=float(lub["np"]))
+    values = matrix.analytical_values(point)
+    for name, v in values.items():
+        assert v == pytest.approx(float(getattr(direct, name)), rel=1e-9), name
+
+
+def test_unknown_figures_are_refused():
+    config = CONFIGS["smoke"]
+    with pytest.raises(ValueError, match="not a sweep figure"):
+        matrix.figure_panels(config, "fig12")
+    with pytest.raises(ValueError, match="not a single-run figure"):
+        matrix.figure_points(config, "fig15")
+    assert matrix.figure_runs(config, "fig03") == []

@@ -1,0 +1,109 @@
+"""The MPM part of the Snakemake workflow, driven from pytest in a temporary copy of the project.
+
+The runs import the installed plough (whose numba cache is warm); the copied ``src/`` provides the
+package sources that every rule takes as an input, as in a checkout.
+"""
+
+import json
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from plough.study import matrix
+
+ROOT = Path(__file__).resolve().parents[1]
+SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+FULL = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+
+def _project_copy(dest: Path) -> Path:
+    for name in ("Snakefile", "config", "workflow", "src"):
+        src = ROOT / name
+        if src.is_dir():
+            shutil.copytree(src, dest / name, ignore=shutil.ignore_patterns("__pycache__", "*.pyc"))
+        else:
+            shutil.copy(src, dest / name)
+    return dest
+
+
+def _snakemake(workdir: Path, *args: str, timeout: int = 600) -> subprocess.CompletedProcess:
+    return subprocess.run([sys.executable, "-m", "snakemake", "--cores", "2", *args], cwd=workdir,
+                          capture_output=True, text=True, timeout=timeout)
+
+
+def _job_counts(text: str) -> dict[str, int]:
+    """The 'Job stats' table of a Snakemake (dry) run: rule -> number of jobs."""
+    lines = text.splitlines()
+    start = lines.index("Job stats:")
+    assert lines[start + 1].split() == ["job", "count"]
+    counts = {}
+    for line in lines[start + 3:]:
+        if not line.strip():
+            break
+        name, count = line.split()
+        counts[name] = int(count)
+    return counts
+
+
+@pytest.mark.slow
+def test_smoke_fig15_runs_extrapolates_draws_and_caches(tmp_path):
+    work = _project_copy(tmp_path)
+    targets = ("results/datasets/fig15.nc", "results/figures/fig15.png")
+    out = _snakemake(work, "--configfile=config/smoke.yaml", *targets)
+    assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+
+    mpm = SMOKE["mpm"]
+    real = mpm["real_materials"]
+    ds = xr.load_dataset(work / "results/datasets/fig15.nc")
+    assert ds["dp"].dims == ("material", "load_N", "h")
+    assert dict(ds.sizes) == {"material": 2, "load_N": len(real["loads_N"]), "h": len(mpm["particle_sizes_um"])}
+    assert list(ds["load_N"].values) == [float(x) for x in real["loads_N"]]
+    assert list(ds["h"].values) == sorted((float(h) for h in mpm["particle_sizes_um"]), reverse=True)
+    for o in (*matrix.OUTPUTS, "Fz_mean", "max_particle_penetration", "wall_time_s"):
+        assert np.isfinite(ds[o].values).all(), o
+    for o in ("mu_h0", "dp_h0", "mu_h0_uncertainty", "dp_h0_uncertainty"):
+        assert np.isfinite(ds[o].values).all(), o
+    assert ds.attrs["plough_version"] and ds.attrs["git_commit"]
+    assert json.loads(ds.attrs["config"])["particle_sizes_um"] == mpm["particle_sizes_um"]
+    assert (work / "results/figures/fig15.png").stat().st_size > 10_000
+    assert (work / "results/figures/fig15.pdf").exists()
+
+    # one result file and one log per run, and only the runs Fig. 15 needs
+    run_ids = matrix.figure_runs(SMOKE, "fig15")
+    assert {p.stem for p in (work / "results/runs").glob("*.nc")} == set(run_ids)
+    for rid in run_ids:
+        log = (work / "logs/runs" / f"{rid}.log").read_text()
+        assert "um slid" in log, rid  # the progress bar
+        assert f"wrote results/runs/{rid}.nc: mu = " in log, rid
+    # the dataset holds the runs' own numbers at their coordinates
+    rid = run_ids[-1]  # steel at the highest load, finest size
+    run = xr.load_dataset(work / "results/runs" / f"{rid}.nc")
+    assert json.loads(run.attrs["scene"])["name"] == rid
+    sel = {"material": "steel", "load_N": float(real["loads_N"][-1]), "h": min(float(h) for h in
+                                                                                mpm["particle_sizes_um"])}
+    for o in ("mu", "dp"):
+        assert math.isclose(float(ds[o].sel(sel)), float(run[o]), rel_tol=1e-12), o
+
+    # nothing left to do: every run and the dataset are cached
+    again = _snakemake(work, "--configfile=config/smoke.yaml", "-n", *targets, timeout=120)
+    assert again.returncode == 0, again.stderr[-3000:]
+    assert "Nothing to be done" in again.stdout + again.stderr
+
+
+def test_full_matrix_dry_run_schedules_every_run_once(tmp_path):
+    work = _project_copy(tmp_path)
+    out = _snakemake(work, "-n", timeout=300)
+    assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+    counts = _job_counts(out.stdout + out.stderr)
+    assert counts["mpm_run"] == len(matrix.all_runs(FULL))
+    assert counts["mpm_dataset"] == len(matrix.MPM_FIGURES) + 1  # and Fig. 22's
+    assert counts["figure"] == len(matrix.MPM_FIGURES) + 3  # and Figs. 3, 4, 22
+    assert counts["numba_warmup"] == 1
+    assert counts["total"] == sum(n for name, n in counts.items() if name != "total")
