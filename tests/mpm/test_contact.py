@@ -43,6 +43,12 @@ def make_case(seed, centre=None, radius=3.3 * DX):
     v_sphere = np.array([0.1, 0.0, -0.02])
     # relative velocities over three decades: slips that the traction stops and slips it only slows
     grid_v = v_sphere + rng.normal(0.0, 1.0, (N_NODES, 3)) * 10.0 ** rng.uniform(-4, -1, N_NODES)[:, None]
+    # and a tenth of the nodes approaching the sphere head-on with barely any slip, so that the
+    # traction (tau / P times the normal impulse) stops them for every interface law
+    slow = rng.random(N_NODES) < 0.1
+    outward = NODES[slow] - centre
+    outward /= np.linalg.norm(outward, axis=1)[:, None]
+    grid_v[slow] = v_sphere - 1e-3 * outward + rng.normal(0.0, 1e-12, (slow.sum(), 3))
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
     w = rng.uniform(0.1, 2.0, N_NODES)
     p0 = 10.0 ** rng.uniform(5, 12, N_NODES) * np.where(rng.random(N_NODES) < 0.15, -1.0, 1.0)
@@ -170,10 +176,6 @@ def test_tangential_impulse_is_traction_limited_and_never_reverses(model, iparam
         t_before = rel[i] - vn[i] * n[i]
         t_after = rel_after[i]  # no normal part left
         vt_b, vt_a = np.linalg.norm(t_before), np.linalg.norm(t_after)
-        # same direction, smaller magnitude: the slip shrinks and never reverses
-        assert vt_a <= vt_b * (1 + 1e-12)
-        np.testing.assert_allclose(np.cross(t_before, t_after), 0.0, atol=1e-12 * vt_b * vt_b)
-        assert t_before @ t_after >= -1e-15
         if cb[i, 7] > 0:
             sig = voigt_to_tensor(cb[i, :6] / cb[i, 7])
             pressure = -n[i] @ sig @ n[i]
@@ -183,10 +185,21 @@ def test_tangential_impulse_is_traction_limited_and_never_reverses(model, iparam
         tau = expected_tau(model, iparams, pressure, kappa)
         assert tau <= kappa * (1 + 1e-15)
         jn = -m[i] * vn[i]
-        area = DX * DX if pressure <= 0 else min(jn / (DT * pressure), DX * DX)
+        p_floor = max(pressure, kappa)  # the contact pressure is floored at the shear strength
+        area = DX * DX if p_floor <= 0 else min(jn / (DT * p_floor), DX * DX)
         if n[i][2] < 0:
             area_xy += area * -n[i][2]
         limit = tau * area * DT
+        if vt_b < 1e-9:
+            # grid_v - v_sphere keeps few digits of such slips: check only that they are stopped or
+            # slowed, never grown beyond round-off
+            assert vt_a <= vt_b + 1e-15
+            n_stopped += bool(vt_a == 0.0 and limit >= m[i] * vt_b)
+            continue
+        # same direction, smaller magnitude: the slip shrinks and never reverses
+        assert vt_a <= vt_b * (1 + 1e-12)
+        np.testing.assert_allclose(np.cross(t_before, t_after), 0.0, atol=1e-12 * vt_b * vt_b)
+        assert t_before @ t_after >= -1e-15
         jt = m[i] * (vt_b - vt_a)  # loses digits to cancellation when jt << m vt
         tol = 1e-12 * m[i] * vt_b
         assert jt <= limit + tol

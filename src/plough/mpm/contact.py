@@ -122,6 +122,21 @@ def interface_shear(model, iparams, pressure, kappa):
 
 
 @njit(cache=True)
+def contact_area(jn, dt, pressure, kappa, dx2):
+    """Area a node's normal impulse acts on, A_i = min(F_n,i / P_i, dx^2) with F_n,i = jn / dt.
+
+    The contact pressure is floored at the shear strength kappa, which bounds the local ratio
+    tau / P by tau / kappa <= 1 where the particles' stress gives little pressure (contact edge,
+    tensile stress); a node covers at most one cell face. A node without material strength
+    (kappa = 0) and no pressure counts one cell face.
+    """
+    p = max(pressure, kappa)
+    if p <= 0.0:
+        return dx2
+    return min(jn / (dt * p), dx2)
+
+
+@njit(cache=True)
 def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sphere, dt, model, iparams, out):
     """Impose the sphere on the nodes inside it and measure the reaction.
 
@@ -187,7 +202,7 @@ def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sp
                     pressure = 0.0
                     kappa = 0.0
                 tau = interface_shear(model, iparams, pressure, kappa)
-                area = dx2 if pressure <= 0.0 else min(jn / (dt * pressure), dx2)
+                area = contact_area(jn, dt, pressure, kappa, dx2)
                 jt = 0.0
                 if vt > 0.0:
                     jt = min(m * vt, tau * area * dt)
