@@ -365,13 +365,10 @@ def test_picture_figures_draw(run_files, tmp_path, figure):
     _draws(figure, _written(ds, tmp_path), tmp_path)
 
 
-@pytest.mark.xfail(strict=True, raises=KeyError,
-                   reason="known bug: mpm_figures.single_run_dataset replaces the run's attributes, so the sphere "
-                          "centre (sphere_centre_end_m) never reaches Fig. 12 and plot_fig12 draws no sphere")
 def test_sphere_position_reaches_the_fig12_picture(run_files):
-    """plot_fig12 draws the sphere from the attribute sphere_centre_end_m that every run file carries."""
+    """plot_fig12 draws the sphere from the run's attribute sphere_centre_end_m, kept per case."""
     ds = build_dataset(SMOKE, "fig12", run_files)
-    np.testing.assert_allclose(ds.attrs["sphere_centre_end_m"], [2e-4, 0.0, 4.9e-4])
+    np.testing.assert_allclose(ds.attrs["sphere_centre_end_m_coated"], [2e-4, 0.0, 4.9e-4])
 
 
 def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):

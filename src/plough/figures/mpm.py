@@ -158,10 +158,9 @@ def plot_fig12(ds: xr.Dataset, outputs) -> None:
     _material_scatter(ax, sub["midplane_x"].values[ok] * 1e6, sub["midplane_z"].values[ok] * 1e6,
                       sub["midplane_coating"].values[ok], 4)
     scene = json.loads(ds.attrs["scene_coated"])
-    centre = ds.attrs.get("sphere_centre_end_m")
-    if centre is not None:
-        r = scene["sphere"]["radius_m"] * 1e6
-        ax.add_patch(Circle((centre[0] * 1e6, centre[2] * 1e6), r, fill=False, color="k"))
+    centre = np.asarray(ds.attrs["sphere_centre_end_m_coated"])
+    r = scene["sphere"]["radius_m"] * 1e6
+    ax.add_patch(Circle((centre[0] * 1e6, centre[2] * 1e6), r, fill=False, color="k"))
     xm = sub["midplane_x"].values[ok] * 1e6
     ax.set_xlim(xm.min(), xm.max())
     ax.set_ylim(sub["midplane_z"].values[ok].min() * 1e6, 0.25 * (xm.max() - xm.min()))

@@ -218,8 +218,9 @@ def figure_runs(config: dict[str, Any], figure: str) -> list[str]:
         return figure_runs(config, "fig21")
     if figure not in SWEEP_FIGURES:
         return []
-    return [run_id(p, h) for panel in figure_panels(config, figure) for s in panel.series for p in s.points
-            for h in particle_sizes_um(config)]
+    ids = (run_id(p, h) for panel in figure_panels(config, figure) for s in panel.series for p in s.points
+           for h in particle_sizes_um(config))
+    return list(dict.fromkeys(ids))  # a run shared by two panels is listed once
 
 
 # ----------------------------------------------------------------------------- scenes

@@ -136,13 +136,15 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
             sub[f"{o}_analytical"] = ((), v, {"units": units, "long_name": f"{long_name} (analytical model)"})
         sub = sub.drop_vars([c for c in ("hx", "hy") if c in sub.coords and "height_map" not in keep])
         sub.attrs = {"scene_" + label: run.attrs["scene"], "coating_representation_" + label:
-                     run.attrs["coating_representation"]}
+                     run.attrs["coating_representation"],
+                     "sphere_centre_end_m_" + label: run.attrs["sphere_centre_end_m"]}
         parts.append(sub.expand_dims(case=[label]))
     ds = xr.concat(parts, dim="case", join="outer", data_vars="all", coords="different",
                    compat="equals", combine_attrs="drop_conflicts")
     if len(parts) > 1:
         for name in ds.data_vars:
-            ds[name].attrs["allow_missing"] = 1  # cases of different size are padded with NaN
+            if ds[name].ndim > 1:
+                ds[name].attrs["allow_missing"] = 1  # cases of different size are padded with NaN
     ds["case"].attrs["long_name"] = "case"
     ds.attrs["particle_size_um"] = h
     return ds
@@ -181,7 +183,8 @@ def build_dataset(config: dict[str, Any], figure: str, paths: Mapping[str, str |
         ds = sweep_dataset(config, figure, runs)
     else:
         raise ValueError(f"figure = {figure!r} is not an MPM figure; allowed: {matrix.MPM_FIGURES}")
-    scene_attrs = {k: v for k, v in ds.attrs.items() if k.startswith(("scene_", "coating_representation_"))}
+    scene_attrs = {k: v for k, v in ds.attrs.items()
+                   if k.startswith(("scene_", "coating_representation_", "sphere_centre_end_m_"))}
     ds.attrs = {**ds.attrs, **provenance_attrs(config["mpm"]), **scene_attrs}
     ds.attrs.update(figure=figure, title=TITLES[figure])
     return ds
