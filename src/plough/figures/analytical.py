@@ -88,8 +88,8 @@ def plot_fig22(ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
             ax.plot(load, sub[name + "_fit"], color=COLOURS[name], label=LABELS[name] + " (power-law fit)")
         if "mu_mpm" in ds:
             mpm = ds["mu_mpm"].sel(ball_diameter_mm=d)
-            ax.errorbar(ds["mpm_load_N"], mpm, yerr=ds["mu_mpm_uncertainty"].sel(ball_diameter_mm=d), fmt="o", color="k",
-                        label="MPM (h -> 0)")
+            unc = ds["mu_mpm_uncertainty"].sel(ball_diameter_mm=d)
+            ax.errorbar(ds["mpm_load_N"], mpm, yerr=unc, fmt="o", color="k", label="MPM (h -> 0)")
         ax.set_yscale("log")
         ax.set_xlabel("normal load Fn (N)")
         ax.set_ylabel("friction coefficient (-)")
