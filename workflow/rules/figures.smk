@@ -6,7 +6,7 @@ rule figure:
         "results/datasets/{figure}.nc",
         PACKAGE_SOURCES,
     output:
-        png="results/figures/{figure}.png",
+        png=report("results/figures/{figure}.png", caption="../report/figure.rst", category="Figures"),
         pdf="results/figures/{figure}.pdf",
     log:
         "logs/figures/{figure}.log",

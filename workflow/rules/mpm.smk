@@ -1,12 +1,5 @@
 # MPM runs (one per job, cached by file), their extrapolation to h -> 0, and the figure datasets.
-from plough.study import matrix
-
-MPM_RUNS = matrix.all_runs(config)
-MPM_THREADS = int(config["mpm"]["threads"])
-
-
-def runs_of(figure):
-    return {rid: f"results/runs/{rid}.nc" for rid in matrix.figure_runs(config, figure)}
+# The run matrix and its helpers are defined in common.smk.
 
 
 # numba compiles its kernels into __pycache__ on first use; parallel first compilations of
@@ -38,8 +31,8 @@ rule mpm_run:
         run="|".join(re.escape(r) for r in MPM_RUNS) if MPM_RUNS else "NO_RUNS",
     threads: MPM_THREADS
     resources:
-        mem_mb=4000,
-        runtime=600,
+        mem_mb=lambda wc: MPM_COST[wc.run].memory_mb,
+        runtime=lambda wc, threads: cost.runtime_minutes(MPM_COST[wc.run], threads),
     log:
         "logs/runs/{run}.log",
     benchmark:

@@ -1,0 +1,60 @@
+"""Projected time of the full reproduction (`snakemake --cores 2`) from per-run costs.
+
+    python benchmarks/reproduction_time.py [--config config/config.yaml]
+
+Counts the particles and steps of every MPM run of the config (plough.study.cost, within a few
+per cent of the solver's counts) and divides by the particle-steps per second measured on the
+reference scene at 2 threads (benchmarks/results/mpm_reference.json, the slowest of its sizes).
+With `--cores 2` and 2 threads per run the runs go one after another, so the total is their sum.
+Writes benchmarks/results/reproduction_time.json and prints a Markdown table.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+import yaml
+
+from plough.mpm.scene import Scene
+from plough.study import cost, matrix
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
+    parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference.json"))
+    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
+    args = parser.parse_args()
+    config = yaml.safe_load(Path(args.config).read_text())
+    measured = json.loads(Path(args.measured).read_text())
+    throughput = min(r["particle_steps_per_s"] for r in measured["runs"])
+    by_size: dict[float, dict[str, float]] = {}
+    for scene in matrix.all_runs(config).values():
+        c = cost.estimate(Scene.from_dict(scene))
+        h = round(scene["discretisation"]["particle_size_m"] * 1e6, 6)
+        row = by_size.setdefault(h, {"runs": 0, "particle_steps": 0.0, "largest_run_particles": 0})
+        row["runs"] += 1
+        row["particle_steps"] += c.particle_steps
+        row["largest_run_particles"] = max(row["largest_run_particles"], c.particles)
+    print(f"throughput used: {throughput / 1e6:.2f} M particle-steps/s (measured, 2 threads)\n")
+    print("| h (um) | runs | particle-steps | largest run (particles) | projected wall time |")
+    print("|---|---|---|---|---|")
+    total = 0.0
+    for h in sorted(by_size, reverse=True):
+        row = by_size[h]
+        row["projected_s"] = row["particle_steps"] / throughput
+        total += row["projected_s"]
+        print(f"| {h:g} | {row['runs']} | {row['particle_steps']:.3g} | {row['largest_run_particles']:,} | "
+              f"{row['projected_s'] / 3600:.1f} h |")
+    print(f"| all | {sum(r['runs'] for r in by_size.values())} | | | {total / 3600:.1f} h ({total / 86400:.1f} days) |")
+    out = {"config": args.config, "throughput_particle_steps_per_s": throughput, "by_size_um": by_size,
+           "total_projected_s": total}
+    Path(args.out).write_text(json.dumps(out, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()

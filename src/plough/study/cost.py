@@ -1,0 +1,71 @@
+"""What an MPM run will cost before it runs: particles, time steps, memory and wall time.
+
+Used for cluster resources (``mem_mb``, ``runtime`` of the Slurm profile) and to project the
+time of the full reproduction from a measured throughput. The counts follow the solver:
+particles fill the half cylinder below z = 0 (a quarter with the mirror plane) on an h lattice; dt = CFL * dx / (c + 2 v) with
+c the mass-scaled P-wave speed of the stiffest layer; the sphere presses at
+``press_speed_fraction * v`` to about the expected ploughing depth, settles, then slides.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from plough.mpm.scene import Scene
+
+#: Bytes per particle (state arrays) plus the grid share at 2 particles per cell and 2 threads,
+#: rounded up; measured peak RSS is below this for the reference scene.
+BYTES_PER_PARTICLE = 400
+BASE_MEMORY_MB = 600  # interpreter, numba, xarray
+SETTLE_STEPS = 300
+
+
+@dataclass(frozen=True)
+class RunCost:
+    particles: int
+    steps: int
+
+    @property
+    def particle_steps(self) -> float:
+        return float(self.particles) * self.steps
+
+    @property
+    def memory_mb(self) -> int:
+        return int(BASE_MEMORY_MB + self.particles * BYTES_PER_PARTICLE / 1e6)
+
+    def wall_time_s(self, particle_steps_per_s: float) -> float:
+        return self.particle_steps / particle_steps_per_s
+
+
+def wave_speed_m_s(scene: Scene) -> float:
+    c = 0.0
+    for m in scene.layers.materials:
+        E, nu = m.youngs_modulus_Pa, m.poisson_ratio
+        K, G = E / (3 * (1 - 2 * nu)), E / (2 * (1 + nu))
+        c = max(c, math.sqrt((K + 4 * G / 3) / (scene.discretisation.mass_scaling * m.density_kg_m3)))
+    return c
+
+
+def estimate(scene: Scene) -> RunCost:
+    """Particles and steps of a run of ``scene`` (within a few per cent of the solver's)."""
+    h = scene.discretisation.particle_size_m
+    dom = scene.domain
+    cross = (0.25 if dom.symmetric else 0.5) * math.pi * dom.radius_m**2  # quarter / half disc below z = 0
+    particles = int(cross * dom.length_m / h**3)
+    v = scene.sliding.speed_m_s
+    dt = scene.discretisation.cfl * scene.discretisation.cell_size_m / (wave_speed_m_s(scene) + 2 * v)
+    _, dp = scene.expected_contact()
+    press = dp / (scene.sliding.press_speed_fraction * v) / dt
+    slide = scene.sliding.distance_m / v / dt
+    return RunCost(particles=particles, steps=int(press + SETTLE_STEPS + slide))
+
+
+#: Particle-steps per second per thread measured on the reference scene
+#: (benchmarks/mpm_reference.py, 2 threads: ~4.6 M/s); used for cluster run-time requests.
+THROUGHPUT_PER_THREAD = 2.3e6
+
+
+def runtime_minutes(cost: RunCost, threads: int, safety: float = 2.0) -> int:
+    """A wall-time request for a cluster job: the projected time times ``safety``, plus 5 min."""
+    return int(math.ceil(safety * cost.particle_steps / (THROUGHPUT_PER_THREAD * threads) / 60.0)) + 5
