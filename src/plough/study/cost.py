@@ -2,8 +2,9 @@
 
 Used for cluster resources (``mem_mb``, ``runtime`` of the Slurm profile) and to project the
 time of the full reproduction from a measured throughput. The counts follow the solver:
-particles fill the half cylinder below z = 0 (a quarter with the mirror plane) on an h lattice; dt = CFL * dx / (c + 2 v) with
-c the mass-scaled P-wave speed of the stiffest layer; the sphere presses at
+particles fill the half cylinder below z = 0 (a quarter with the mirror plane) on an h lattice;
+dt = CFL * dx / (c + 2 v) with c the mass-scaled P-wave speed of the stiffest layer; the sphere
+presses at
 ``press_speed_fraction * v`` to about the expected ploughing depth, settles, then slides.
 """
 
