@@ -26,6 +26,7 @@ SHAPE = np.array([12, 11, 13], dtype=np.int64)
 ORIGIN = np.array([-4e-5, -5e-5, -6e-5])
 NODES = Grid(origin=ORIGIN, dx=DX, shape=tuple(int(s) for s in SHAPE)).node_positions()
 N_NODES = NODES.shape[0]
+NO_FLAGS = np.zeros(N_NODES, dtype=np.int8)  # every node free (no mirror ghosts)
 DT = 1e-3  # large, so that both the traction limit and the stop-the-slip limit occur
 
 
@@ -69,7 +70,7 @@ def call(case, model, iparams):
     grid_v = case["grid_v"].copy()
     cbuf = case["cbuf"].copy()
     out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(case["grid_m"], grid_v, cbuf, ORIGIN, DX, SHAPE, case["centre"], case["radius"],
+    ct.sphere_contact(case["grid_m"], grid_v, cbuf, NO_FLAGS, ORIGIN, DX, SHAPE, case["centre"], case["radius"],
                       case["v_sphere"], DT, model, np.asarray(iparams, float), out)
     return grid_v, cbuf, out
 
@@ -150,7 +151,7 @@ def test_pressing_on_resting_material_gives_upward_normal_force():
     cbuf[:, 8] = 1.0  # touching, but no stress: kappa = 0
     out = np.zeros(ct.N_OUT)
     v_sphere = np.array([0.0, 0.0, -0.05])
-    ct.sphere_contact(grid_m, grid_v, cbuf, ORIGIN, DX, SHAPE, centre, 3.3 * DX, v_sphere, DT,
+    ct.sphere_contact(grid_m, grid_v, cbuf, NO_FLAGS, ORIGIN, DX, SHAPE, centre, 3.3 * DX, v_sphere, DT,
                       ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), out)
     assert out[ct.OUT_FN + 2] > 0  # material pushes the sphere up
     # nodes below the centre move down with the sphere's normal velocity

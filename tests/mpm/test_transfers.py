@@ -22,7 +22,7 @@ import pytest
 from plough.materials import rigid_plastic
 from plough.mpm import transfers as tr
 from plough.mpm.constitutive import I_G, I_K, pack_materials
-from plough.mpm.grid import FIXED, FREE, MIRROR, Grid, make_grid
+from plough.mpm.grid import FIXED, FREE, GHOST, MIRROR, Grid, boundary_flags, make_grid, mirror_plane_index
 
 DX = 1e-5
 SHAPE = np.array([17, 16, 18], dtype=np.int64)  # non-cubic: catches index mix-ups
@@ -55,7 +55,7 @@ def p2g_update(x, v, C, stress, vol0, J, mass, dt, n_chunks=1, flags=None):
     grid_v = np.zeros((n_nodes, 3))
     if flags is None:
         flags = np.full(n_nodes, FREE, dtype=np.int8)
-    tr.grid_update(buf, flags, grid_m, grid_v)
+    tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1)
     return buf, grid_m, grid_v
 
 
@@ -317,7 +317,7 @@ def test_grid_update_boundary_conditions():
     flags = rng.choice(np.array([FREE, FIXED, MIRROR], dtype=np.int8), n_nodes)
     grid_m = np.full(n_nodes, -1.0)
     grid_v = np.full((n_nodes, 3), 99.0)
-    tr.grid_update(buf, flags, grid_m, grid_v)
+    tr.grid_update(buf, flags, grid_m, grid_v, np.array([1, 1, n_nodes], dtype=np.int64), -1)
     m = buf[:, :, 0].sum(0)
     mom = buf[:, :, 1:].sum(0)
     np.testing.assert_allclose(grid_m, m, rtol=1e-15)
@@ -343,3 +343,52 @@ def test_make_grid_covers_block_with_padding():
         assert np.all(g.upper >= hi + 3 * dx - 1e-12 * dx)
         assert g.node_positions().shape == (g.n_nodes, 3)
         assert math.isclose(g.node_positions()[1, 2] - g.node_positions()[0, 2], dx)
+
+
+def test_mirror_fold_reproduces_the_full_domain():
+    """Half domain with the mirror fold == full domain with the mirrored particles, node by node."""
+    rng = np.random.default_rng(7)
+    dx = 1e-5
+    half_grid = make_grid(2e-4, 8e-5, True, dx, 3e-5)
+    full_grid = make_grid(2e-4, 8e-5, False, dx, 3e-5)
+    n = 400
+    x = np.column_stack([rng.uniform(3e-5, 1.7e-4, n), rng.uniform(0.0, 5e-5, n), rng.uniform(-6e-5, 0.0, n)])
+    v = rng.normal(0.0, 0.1, (n, 3))
+    C = rng.normal(0.0, 1e3, (n, 3, 3))
+    stress = rng.normal(0.0, 1e8, (n, 6))
+    vol0, J, mass = np.full(n, (0.5 * dx) ** 3), np.ones(n), np.full(n, RHO * (0.5 * dx) ** 3)
+    mirror = np.diag([1.0, -1.0, 1.0])
+    x_m, v_m = x @ mirror, v @ mirror
+    C_m = mirror @ C @ mirror  # velocity gradient of the mirrored field
+    stress_m = stress * np.array([1, 1, 1, -1, 1, -1])  # yz and xy change sign
+
+    def grid_v(grid, xs, vs, Cs, ss, symmetric):
+        shape = np.array(grid.shape, dtype=np.int64)
+        buf = tr.allocate_grid_buffers(1, grid.n_nodes)
+        tr.p2g(xs, vs, Cs, ss, np.tile(vol0, len(xs) // n), np.tile(J, len(xs) // n), np.tile(mass, len(xs) // n),
+               grid.origin, dx, 1e-7, shape, buf)
+        flags = boundary_flags(grid, 1.0, symmetric)  # radius 1 m: nothing fixed
+        gm, gv = np.zeros(grid.n_nodes), np.zeros((grid.n_nodes, 3))
+        tr.grid_update(buf, flags, gm, gv, shape, mirror_plane_index(grid, symmetric))
+        return gm, gv, flags
+
+    gm_h, gv_h, flags_h = grid_v(half_grid, x, v, C, stress, True)
+    gm_f, gv_f, _ = grid_v(full_grid, np.vstack([x, x_m]), np.vstack([v, v_m]), np.vstack([C, C_m]),
+                           np.vstack([stress, stress_m]), False)
+    pos_h, pos_f = half_grid.node_positions(), full_grid.node_positions()
+    index_f = {tuple(np.round(q / dx).astype(int)): i for i, q in enumerate(pos_f)}
+    checked = 0
+    for i, q in enumerate(pos_h):
+        j = index_f.get(tuple(np.round(q / dx).astype(int)))
+        if j is None or gm_f[j] == 0.0:
+            continue
+        checked += 1
+        if flags_h[i] == MIRROR:  # the plane keeps the half body's mass; v_y = 0 there
+            assert gm_h[i] == pytest.approx(0.5 * gm_f[j], rel=1e-12)
+            np.testing.assert_allclose(gv_h[i, [0, 2]], gv_f[j, [0, 2]], rtol=1e-9, atol=1e-12)
+            assert gv_h[i, 1] == 0.0 and abs(gv_f[j, 1]) < 1e-9
+        else:  # interior nodes and ghosts alike
+            assert flags_h[i] in (FREE, GHOST)
+            assert gm_h[i] == pytest.approx(gm_f[j], rel=1e-12)
+            np.testing.assert_allclose(gv_h[i], gv_f[j], rtol=1e-9, atol=1e-12)
+    assert checked > 100

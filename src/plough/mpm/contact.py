@@ -30,6 +30,7 @@ import math
 from numba import njit
 
 from plough.mpm.constitutive import mixed_flow_stress
+from plough.mpm.grid import GHOST, MIRROR
 from plough.mpm.shape import bspline2
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
@@ -137,7 +138,8 @@ def contact_area(jn, dt, pressure, kappa, dx2):
 
 
 @njit(cache=True)
-def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sphere, dt, model, iparams, out):
+def sphere_contact(grid_m, grid_v, cbuf, flags, origin, dx, shape, centre, radius, v_sphere, dt, model, iparams,
+                   out):
     """Impose the sphere on the nodes inside it and measure the reaction.
 
     Reads grid_m, cbuf (from scatter_contact_stress; its entries are zeroed here). Writes
@@ -171,8 +173,8 @@ def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sp
                 for k in range(N_CBUF):
                     cbuf[node, k] = 0.0
                 m = grid_m[node]
-                if m <= 0.0 or not touching:
-                    continue
+                if m <= 0.0 or not touching or flags[node] == GHOST:
+                    continue  # ghosts (y < 0) mirror their partners: their impulse is not the body's
                 dist = math.sqrt(d2)
                 if dist <= 0.0:
                     continue
@@ -202,7 +204,8 @@ def sphere_contact(grid_m, grid_v, cbuf, origin, dx, shape, centre, radius, v_sp
                     pressure = 0.0
                     kappa = 0.0
                 tau = interface_shear(model, iparams, pressure, kappa)
-                area = contact_area(jn, dt, pressure, kappa, dx2)
+                # a node on the mirror plane carries the half body's share: half its cell face
+                area = contact_area(jn, dt, pressure, kappa, 0.5 * dx2 if flags[node] == MIRROR else dx2)
                 jt = 0.0
                 if vt > 0.0:
                     jt = min(m * vt, tau * area * dt)

@@ -3,7 +3,8 @@
 Nodes sit at origin + (i, j, k) dx. Node data live in flat arrays indexed by
 ``(i * ny + j) * nz + k`` (z fastest, matching the particle seeding order for cache locality).
 Boundary flags per node: 0 free, 1 fixed (outside the curved surface of the half cylinder: the
-paper fixes that surface), 2 mirror plane (y <= 0 with symmetry: the normal velocity vanishes).
+paper fixes that surface), 2 mirror plane (y = 0 with symmetry: the normal velocity vanishes),
+3 ghost (y < 0 with symmetry: the mirror image of the node at -y, see ``transfers.grid_update``).
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-FREE, FIXED, MIRROR = 0, 1, 2
+FREE, FIXED, MIRROR, GHOST = 0, 1, 2, 3
 #: Cells of padding beyond the particles so that every 27-node stencil lies on the grid.
 PAD_CELLS = 3
 
@@ -46,16 +47,27 @@ def make_grid(length_m: float, radius_m: float, symmetric: bool, dx: float, head
     return Grid(origin=lo, dx=dx, shape=shape)
 
 
+def mirror_plane_index(grid: Grid, symmetric: bool) -> int:
+    """Index j of the node plane y = 0 with symmetry, -1 without."""
+    if not symmetric:
+        return -1
+    j0 = int(round(-grid.origin[1] / grid.dx))
+    if abs(grid.origin[1] + j0 * grid.dx) > 1e-9 * grid.dx:
+        raise ValueError("the grid has no node plane at y = 0")
+    return j0
+
+
 def boundary_flags(grid: Grid, radius_m: float, symmetric: bool) -> np.ndarray:
-    """Per-node boundary flag (FREE, FIXED, MIRROR) for the half-cylinder block.
+    """Per-node boundary flag (FREE, FIXED, MIRROR, GHOST) for the half-cylinder block.
 
     Nodes at or beyond the curved surface y^2 + z^2 >= R^2 (below the top face) are fixed; with
-    symmetry, nodes with y <= 0 carry the mirror condition v_y = 0.
+    symmetry, nodes on y = 0 carry the mirror condition v_y = 0 and nodes with y < 0 are ghosts.
     """
     pos = grid.node_positions()
     y, z = pos[:, 1], pos[:, 2]
     flags = np.full(grid.n_nodes, FREE, dtype=np.int8)
     if symmetric:
-        flags[y <= 1e-12 * grid.dx] = MIRROR
+        flags[np.abs(y) <= 1e-9 * grid.dx] = MIRROR
+        flags[y < -1e-9 * grid.dx] = GHOST
     flags[(y * y + z * z >= radius_m * radius_m) & (z < 0)] = FIXED
     return flags

@@ -3,7 +3,8 @@
 One step (model.md section 2):
 
 1. P2G: particle mass, momentum and stress divergence to the grid (APIC/MLS).
-2. Grid update: nodal velocities with the internal force; fixed curved surface, mirror plane.
+2. Grid update: nodal velocities with the internal force; fixed curved surface, mirror plane
+   (exact: nodes at +y also get their ghosts' contributions, ghosts mirror them after contact).
 3. Contact: the rigid sphere on the nodes inside it, traction-limited interface shear (eq. 8);
    the reaction is the force on the sphere.
 4. Sphere motion: pressing, then sliding along x; its height floats under load control.
@@ -29,7 +30,7 @@ from plough.materials import (
 )
 from plough.mpm import contact, transfers
 from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
-from plough.mpm.grid import Grid, boundary_flags, make_grid
+from plough.mpm.grid import Grid, boundary_flags, make_grid, mirror_plane_index
 from plough.mpm.particles import Particles, seed_particles
 from plough.mpm.scene import Scene
 
@@ -86,6 +87,7 @@ class Constants:
     sphere_radius: float
     steps_slide: int
     shape: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.int64))
+    mirror_j0: int = -1  # index of the node plane y = 0 with symmetry, -1 without
 
 
 @dataclass
@@ -165,7 +167,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
-        shape=np.array(grid.shape, dtype=np.int64),
+        shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
@@ -196,12 +198,14 @@ def step(s: State, c: Constants) -> None:
     p, w, sph = s.particles, s.work, s.sphere
     g = c.grid
     transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf)
-    transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v)
+    transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v, c.shape, c.mirror_j0)
     contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
                                    p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
                                    w.cbuf)
-    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
+    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
                            sph.velocity, c.dt, c.interface_model, c.interface_params, w.contact_out)
+    if c.mirror_j0 >= 0:
+        transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0)
     move_sphere(sph, c)
     transfers.g2p(w.grid_v, g.origin, g.dx, c.dt, c.shape, p.x, p.v, p.C, p.stress, p.J, p.vol0, p.mass, p.eps_p,
                   p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney, sph.centre,

@@ -24,7 +24,7 @@ import numpy as np
 from numba import njit, prange
 
 from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
-from plough.mpm.grid import FIXED, MIRROR
+from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import APIC_D_INV_FACTOR, bspline2
 
 # per-chunk accumulators written by g2p
@@ -94,14 +94,22 @@ def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf):
 
 
 @njit(cache=True, parallel=True)
-def grid_update(grid_buf, flags, grid_m, grid_v):
+def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
     """Sum the chunk copies into nodal mass and velocity and apply the boundary conditions.
 
-    Reads grid_buf (P2G output) and flags (FREE / FIXED / MIRROR). Writes grid_m[node] and
+    Reads grid_buf (P2G output), flags (FREE / FIXED / MIRROR / GHOST), the grid shape and the
+    index ``mirror_j0`` of the node plane y = 0 (-1 without symmetry). Writes grid_m[node] and
     grid_v[node, 0:3] (velocity at the end of the step before contact). Each node is owned by
-    one iteration, so the reduction is race-free.
+    one iteration and only reads the buffers, so the reduction is race-free.
+
+    Mirror symmetry is exact, not just v_y = 0 on the plane: a node at y = +j dx also receives
+    what the mirror images of the particles would give it, i.e. the contributions its ghost at
+    -j dx received, with the y momentum reversed (and the ghost gets the mirror image of the
+    sum). A half domain then reproduces the full domain's grid state to round-off. Nodes on the
+    plane keep their own (half) mass with v_y = 0, so impulses there are the half body's share.
     """
     n_chunks = grid_buf.shape[0]
+    ny, nz = shape[1], shape[2]
     for node in prange(grid_m.shape[0]):
         m = 0.0
         p0 = 0.0
@@ -112,6 +120,16 @@ def grid_update(grid_buf, flags, grid_m, grid_v):
             p0 += grid_buf[c, node, 1]
             p1 += grid_buf[c, node, 2]
             p2 += grid_buf[c, node, 3]
+        if mirror_j0 >= 0:
+            j = (node // nz) % ny
+            jm = 2 * mirror_j0 - j
+            if j != mirror_j0 and 0 <= jm < ny:
+                partner = node + (jm - j) * nz
+                for c in range(n_chunks):
+                    m += grid_buf[c, partner, 0]
+                    p0 += grid_buf[c, partner, 1]
+                    p1 -= grid_buf[c, partner, 2]
+                    p2 += grid_buf[c, partner, 3]
         grid_m[node] = m
         if m <= 0.0 or flags[node] == FIXED:
             grid_v[node, 0] = 0.0
@@ -121,6 +139,26 @@ def grid_update(grid_buf, flags, grid_m, grid_v):
         grid_v[node, 0] = p0 / m
         grid_v[node, 1] = 0.0 if flags[node] == MIRROR else p1 / m
         grid_v[node, 2] = p2 / m
+
+
+@njit(cache=True, parallel=True)
+def mirror_ghosts(grid_v, flags, shape, mirror_j0):
+    """Ghost nodes (y < 0) take the mirror image of their partner's velocity after contact.
+
+    Reads grid_v of nodes with y > 0; writes grid_v of GHOST nodes (each written once).
+    """
+    ny, nz = shape[1], shape[2]
+    for node in prange(grid_v.shape[0]):
+        if flags[node] != GHOST:
+            continue
+        j = (node // nz) % ny
+        jm = 2 * mirror_j0 - j
+        if jm >= ny:
+            continue
+        partner = node + (jm - j) * nz
+        grid_v[node, 0] = grid_v[partner, 0]
+        grid_v[node, 1] = -grid_v[partner, 1]
+        grid_v[node, 2] = grid_v[partner, 2]
 
 
 @njit(cache=True, parallel=True)

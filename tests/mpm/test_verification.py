@@ -1,0 +1,104 @@
+"""Physics verification of the MPM solver: Hertz, energy balance, mirror symmetry (issue 3).
+
+Slow runs (a few seconds to ~20 s each); the numbers they check are reported in the README.
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+import pytest
+
+from plough.mpm import contact, solver
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+
+pytestmark = pytest.mark.slow
+
+R_M, E_PA, NU = 200e-6, 210e9, 0.3
+
+
+@pytest.fixture(scope="module", autouse=True)
+def two_threads():
+    old = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    yield
+    numba.set_num_threads(old)
+
+
+def indentation_force(h_um: float, depth_um: float, domain_um: float = 240.0) -> float:
+    """Full-body normal force on the sphere held at a depth (no sliding), elastic block."""
+    scene = Scene.from_dict({
+        "name": "hertz", "load_N": 1.0, "sphere": {"radius_um": R_M * 1e6},
+        "layers": {"substrate": {"rigid_plastic_hardness_MPa": 1e6}},  # never yields
+        "interface": {"model": "proportional", "f": 0.0},
+        "domain": {"radius_um": domain_um, "length_um": 2 * domain_um, "symmetric": True},
+        "sliding": {"distance_um": 100, "control": "displacement", "depth_um": depth_um},
+        "discretisation": {"particle_size_um": h_um, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1e6},
+    })
+    state, const = solver.init(scene)
+    state.sphere.centre[0] = 0.5 * scene.domain.length_m
+    fz = []
+    while state.sphere.phase != "slide":  # press to the depth, then settle (SETTLE_STEPS)
+        solver.step(state, const)
+        out = state.work.contact_out
+        fz.append(const.symmetry_factor * (out[contact.OUT_FN + 2] + out[contact.OUT_FT + 2]))
+    assert state.particles.eps_p.max() == 0.0  # purely elastic
+    return float(np.mean(fz[-100:]))
+
+
+def test_hertz_indentation_error_shrinks_with_h():
+    """F = 4/3 E* sqrt(R) d^1.5 for a rigid sphere on an elastic half-space (depth d = 2 um).
+
+    Measured (README): +102% at h = 10 um, +33% at h = 5 um, +20% at h = 2.5 um with a block of
+    12 contact radii; the contact acts on grid nodes up to one cell outside the sphere, an error
+    of order h that halving h more than halves.
+    """
+    depth = 2e-6
+    hertz = 4.0 / 3.0 * E_PA / (1 - NU**2) * np.sqrt(R_M) * depth**1.5
+    err = {h: indentation_force(h, depth * 1e6) / hertz - 1.0 for h in (10.0, 5.0)}
+    assert err[10.0] > err[5.0] > 0.0
+    assert err[5.0] < 0.5 * err[10.0]
+
+
+def tiny_sliding_scene(symmetric: bool) -> Scene:
+    return Scene.from_dict({
+        "name": "sym", "load_N": 1.0, "sphere": {"radius_um": 200},
+        "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
+        "interface": {"model": "proportional", "f": 1.0},
+        "domain": {"radius_um": 80, "length_um": 400, "symmetric": symmetric},
+        "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
+        "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
+        "outputs": {"steady_window": [0.5, 1.0], "records": 40},
+    })
+
+
+@pytest.fixture(scope="module")
+def half_and_full():
+    return (simulate(tiny_sliding_scene(True), progress=False),
+            simulate(tiny_sliding_scene(False), progress=False))
+
+
+def test_mirror_symmetry_half_and_full_domain_agree(half_and_full):
+    half, full = half_and_full
+    assert full.attrs["cost_particles"] == 2 * half.attrs["cost_particles"]
+    assert float(half.mu) == pytest.approx(float(full.mu), rel=0.01)
+    assert float(half.dp) == pytest.approx(float(full.dp), rel=0.01)
+    # the full body carries no net lateral force
+    assert abs(float(full.Fy[full.in_steady_window].mean())) < 0.01 * float(full.Fz_mean)
+
+
+def test_energy_balance(half_and_full):
+    """External work = plastic + elastic + kinetic + interface slip + inelastic contact loss.
+
+    Tolerance 10%: the terms are accumulated independently (grid impulses for the work and the
+    two contact losses, particle stress power for the plastic and elastic parts), and the
+    APIC transfers dissipate a little kinetic energy that no term counts; the measured sum
+    exceeds the work by 7% on the reference scene at h = 10 um (README: an open item).
+    """
+    for ds in half_and_full:
+        work = float(ds.external_work[-1])
+        parts = sum(float(ds[k][-1]) for k in ("plastic_work", "elastic_energy", "kinetic_energy",
+                                               "interface_dissipation", "contact_impact_loss"))
+        assert work > 0
+        assert parts == pytest.approx(work, rel=0.10)
