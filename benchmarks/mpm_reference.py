@@ -30,18 +30,23 @@ def main() -> None:
     parser.add_argument("--scene", default=str(ROOT / "examples" / "uncoated_rigid_plastic.yaml"))
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[10.0, 5.0])
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--k1", type=float, default=125.0, help="analytical model's k1 (coated scenes)")
+    parser.add_argument("--sized-domain", action="store_true", help="size the block from the expected contact")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "mpm_reference.json"))
     args = parser.parse_args()
     numba.set_num_threads(args.threads)
     base = Scene.from_yaml(Path(args.scene))
-    H = 3.0 * base.layers.substrate.flow.sigma_y_Pa
-    ana = ploughing(base.load_N, base.sphere.radius_m, 0.0, H, H)
+    Hs = 3.0 * base.layers.substrate.flow.sigma_y_Pa
+    Hc = 3.0 * base.layers.coating.flow.sigma_y_Pa if base.layers.coated else Hs
+    ana = ploughing(base.load_N, base.sphere.radius_m, base.layers.coating_thickness_m, Hc, Hs, k1=args.k1)
     rows = []
     print("| h (um) | particles | steps | wall (s) | M particle-steps/s | mu | mu_pl | mu_sh | dp (um) | "
           "penetration (um) | Fz mean / load |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
     for h in args.sizes_um:
         scene = replace(base, discretisation=replace(base.discretisation, particle_size_m=h * 1e-6))
+        if args.sized_domain:
+            scene = scene.with_sized_domain()
         ds = simulate(scene, progress=False)
         row = {"h_um": h, **{k: float(ds[k]) for k in ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration",
                                                        "Fz_mean", "max_particle_penetration")},
@@ -55,7 +60,8 @@ def main() -> None:
           f"{float(ana.dp) * 1e6:.2f} | | |")
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(json.dumps({
-        "scene": base.to_dict(), "threads": args.threads, "plough_version": __version__, "git_commit": git_commit(),
+        "scene": base.to_dict(), "threads": args.threads, "sized_domain": args.sized_domain, "k1": args.k1,
+        "plough_version": __version__, "git_commit": git_commit(),
         "analytical": {"mu": float(ana.mu), "mu_pl": float(ana.mu_pl), "mu_sh": float(ana.mu_sh), "dp": float(ana.dp)},
         "runs": rows}, indent=2))
 
