@@ -1,0 +1,89 @@
+"""Stability stress matrix (preliminary, issue 5): extreme numerical settings and scenes on a small
+rigid-plastic scene (r = 0.2 mm, 1 N, h = 10 um, 0.2 mm slide, sized block).
+
+    python benchmarks/stability_matrix.py
+
+Each case either completes — then mu, Fz/load, the deepest particle penetration into the sphere
+(in units of h) and the energy ratio (sum of the energy terms / external work) are reported — or
+stops with the solver's error, which is reported verbatim. Writes
+benchmarks/results/stability_matrix.json and prints a Markdown table.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import numba
+
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+from plough.mpm.solver import SimulationError
+
+ROOT = Path(__file__).resolve().parents[1]
+BASE = {
+    "name": "stability", "load_N": 1.0, "sphere": {"radius_um": 200},
+    "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
+    "interface": {"model": "proportional", "f": 1.0},
+    "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
+    "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
+    "outputs": {"steady_window": [0.5, 1.0], "records": 40},
+}
+ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss")
+
+
+def variant(**changes) -> dict:
+    d = json.loads(json.dumps(BASE))
+    for path, value in changes.items():
+        *keys, last = path.split(".")
+        node = d
+        for k in keys:
+            node = node[k]
+        node[last] = value
+    return d
+
+
+CASES = {
+    "defaults (cfl 0.3, ms 1e6)": variant(),
+    "cfl 0.6": variant(**{"discretisation.cfl": 0.6}),
+    "cfl 0.9": variant(**{"discretisation.cfl": 0.9}),
+    "cfl 1.0 (the accepted maximum)": variant(**{"discretisation.cfl": 1.0}),
+    "mass scaling 1e4": variant(**{"discretisation.mass_scaling": 1e4}),
+    "mass scaling 1e8": variant(**{"discretisation.mass_scaling": 1e8}),
+    "mass scaling 1e9": variant(**{"discretisation.mass_scaling": 1e9}),
+    "speed 1 m/s": variant(**{"sliding.speed_m_s": 1.0}),
+    "H~ = 0.1 coating, t = 25 um": variant(**{"layers": {"coating_thickness_um": 25,
+                                                           "coating": {"rigid_plastic_hardness_MPa": 90},
+                                                           "substrate": {"rigid_plastic_hardness_MPa": 900}}}),
+    "t = 200 um (bulk coating)": variant(**{"layers": {"coating_thickness_um": 200,
+                                                         "coating": {"rigid_plastic_hardness_MPa": 450},
+                                                         "substrate": {"rigid_plastic_hardness_MPa": 900}}}),
+    "long slide 0.6 mm": variant(**{"sliding.distance_um": 600}),
+}
+
+
+def main() -> None:
+    numba.set_num_threads(2)
+    rows = {}
+    print("| case | outcome | mu | Fz / load | max particle penetration / h | energy terms / work |")
+    print("|---|---|---|---|---|---|")
+    for name, d in CASES.items():
+        try:
+            scene = Scene.from_dict(d).with_sized_domain()
+            ds = simulate(scene, progress=False)
+        except (ValueError, SimulationError) as exc:
+            rows[name] = {"outcome": f"{type(exc).__name__}: {exc}"}
+            print(f"| {name} | stopped: {exc} | | | | |", flush=True)
+            continue
+        h = scene.discretisation.particle_size_m
+        ratio = sum(float(ds[k][-1]) for k in ENERGY_TERMS) / float(ds.external_work[-1])
+        rows[name] = {"outcome": "completed", "mu": float(ds.mu), "Fz_over_load": float(ds.Fz_mean) / scene.load_N,
+                      "max_penetration_over_h": float(ds.max_particle_penetration) / h, "energy_ratio": ratio}
+        r = rows[name]
+        print(f"| {name} | completed | {r['mu']:.3f} | {r['Fz_over_load']:.4f} | {r['max_penetration_over_h']:.3f} | "
+              f"{ratio:.3f} |", flush=True)
+    (ROOT / "benchmarks" / "results" / "stability_matrix.json").write_text(json.dumps(rows, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
