@@ -64,6 +64,13 @@ def steady_window_mask(slid_m: np.ndarray, scene: Scene) -> np.ndarray:
     return (slid_m >= lo * d - 1e-12) & (slid_m <= hi * d + tol)
 
 
+def _y_edges(scene: Scene) -> np.ndarray:
+    """Bin edges across the groove, one particle size wide, over the block's width."""
+    h = scene.discretisation.particle_size_m
+    y_max = scene.domain.radius_m
+    return np.arange(0.0 if scene.domain.symmetric else -y_max, y_max + 0.5 * h, h)
+
+
 def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float) -> tuple:
     """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
     h = scene.discretisation.particle_size_m
@@ -81,9 +88,7 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
         raise ValueError("the slide is too short to measure a residual groove behind the sphere "
                          "(sliding.distance_m must exceed ~2.7 contact radii)")
     sections = np.linspace(x_lo, x_hi, scene.outputs.profile_sections)
-    y_max = scene.domain.radius_m
-    y_min = 0.0 if scene.domain.symmetric else -y_max
-    edges = np.arange(y_min, y_max + 0.5 * h, h)
+    edges = _y_edges(scene)
     centres = 0.5 * (edges[1:] + edges[:-1])
     top = p.x[:, 2] + 0.5 * h * np.cbrt(p.J)  # the top face of each particle's cube
     profiles = []
@@ -123,7 +128,7 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
     hmap[~np.isfinite(hmap)] = np.nan
 
     depth = scene.outputs.buried_profile_depth_m
-    y_edges = np.arange(0.0 if scene.domain.symmetric else -scene.domain.radius_m, scene.domain.radius_m + 0.5 * h, h)
+    y_edges = _y_edges(scene)  # the bins of residual_profiles: profile_z and buried_profile_z share y
     in_sections = np.zeros(p.n, dtype=bool)
     for xs in sections:
         in_sections |= np.abs(x - xs) < 0.5 * h

@@ -35,9 +35,6 @@ class RunCost:
     def memory_mb(self) -> int:
         return int(BASE_MEMORY_MB + self.particles * BYTES_PER_PARTICLE / 1e6)
 
-    def wall_time_s(self, particle_steps_per_s: float) -> float:
-        return self.particle_steps / particle_steps_per_s
-
 
 def wave_speed_m_s(scene: Scene) -> float:
     c = 0.0
