@@ -5,7 +5,10 @@ A hand-made grid with random nodal masses, velocities and contact stresses is gi
 impenetrability of approaching contact nodes (within one cell of the sphere surface or inside it,
 carrying a touching particle), untouched separating, non-touching and outside nodes, reaction =
 minus the impulses, the traction-limited tangential impulse that never reverses the slip, the
-energy account, and the consumption of the contact stress buffer.
+energy account, and the consumption of the contact stress buffer. Single calls without contact
+memory (filter weight 1) reduce the filtered area to the step's own normal force; separate tests
+cover the gap-limited approach of nodes whose closest particle has not reached the sphere yet and
+the persistent contact (memory, release).
 """
 
 from __future__ import annotations
@@ -60,18 +63,23 @@ def make_case(seed, centre=None, radius=3.3 * DX):
     cbuf[:, :6] = w[:, None] * sig
     cbuf[:, 6] = w * kappa
     cbuf[:, 7] = w
-    cbuf[:, 8] = rng.random(N_NODES) < 0.85  # a particle of the node touches the sphere
+    cbuf[:, 8] = DX * (rng.random(N_NODES) < 0.85)  # proximity DX - gap: a particle of the node touches
     cbuf[rng.random(N_NODES) < 0.05, :] = 0.0  # nodes no particle reached
     return dict(grid_m=grid_m, grid_v=grid_v, cbuf=cbuf, centre=np.asarray(centre, float), radius=radius,
                 v_sphere=v_sphere)
+
+
+def no_memory():
+    """Contact memory of a first step: no node held, the filter takes the step's force as it is."""
+    return np.zeros(N_NODES), np.full(N_NODES, -2, dtype=np.int64), 0, 1.0
 
 
 def call(case, model, iparams):
     grid_v = case["grid_v"].copy()
     cbuf = case["cbuf"].copy()
     out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(case["grid_m"], grid_v, cbuf, NO_FLAGS, ORIGIN, DX, SHAPE, case["centre"], case["radius"],
-                      case["v_sphere"], DT, model, np.asarray(iparams, float), out)
+    ct.sphere_contact(case["grid_m"], grid_v, cbuf, NO_FLAGS, *no_memory(), ORIGIN, DX, SHAPE, case["centre"],
+                      case["radius"], case["v_sphere"], DT, model, np.asarray(iparams, float), out)
     return grid_v, cbuf, out
 
 
@@ -148,10 +156,10 @@ def test_pressing_on_resting_material_gives_upward_normal_force():
     grid_m = rng.uniform(0.5e-3, 1.5e-3, N_NODES)
     grid_v = np.zeros((N_NODES, 3))
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    cbuf[:, 8] = 1.0  # touching, but no stress: kappa = 0
+    cbuf[:, 8] = DX  # touching, but no stress: kappa = 0
     out = np.zeros(ct.N_OUT)
     v_sphere = np.array([0.0, 0.0, -0.05])
-    ct.sphere_contact(grid_m, grid_v, cbuf, NO_FLAGS, ORIGIN, DX, SHAPE, centre, 3.3 * DX, v_sphere, DT,
+    ct.sphere_contact(grid_m, grid_v, cbuf, NO_FLAGS, *no_memory(), ORIGIN, DX, SHAPE, centre, 3.3 * DX, v_sphere, DT,
                       ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), out)
     assert out[ct.OUT_FN + 2] > 0  # material pushes the sphere up
     # nodes below the centre move down with the sphere's normal velocity
@@ -286,7 +294,8 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     # independent accumulation
     sy = np.array([450e6 / 3, 900e6 / 3])
     kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
-    touching = np.linalg.norm(x - centre, axis=1) - radius <= 0.5 * np.cbrt(vol0 * J)
+    gap = np.linalg.norm(x - centre, axis=1) - radius - 0.5 * np.cbrt(vol0 * J)
+    touching = gap <= 0.0
     assert 0 < (touching & (near == 1)).sum() < (near == 1).sum()
     expected = np.zeros_like(cbuf)
     reach = np.linalg.norm(NODES - centre, axis=1) < radius + DX
@@ -305,9 +314,111 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
                     expected[node, :6] += w * stress[p]
                     expected[node, 6] += w * kappa[p]
                     expected[node, 7] += w
-                    if touching[p]:
-                        expected[node, 8] = 1.0
+                    expected[node, 8] = max(expected[node, 8], DX - gap[p])
     np.testing.assert_array_equal(cbuf[~reach], 0.0)
     assert (cbuf[reach, 7] > 0).sum() > 10
-    assert 0 < (cbuf[reach, 8] > 0).sum() < (cbuf[reach, 7] > 0).sum()
+    assert 0 < (cbuf[reach, 8] >= DX).sum() < (cbuf[reach, 8] > 0).sum() <= (cbuf[reach, 7] > 0).sum()
     np.testing.assert_allclose(cbuf, expected, rtol=1e-12, atol=1e-12 * np.abs(expected).max())
+
+
+# ----------------------------------------------------------------------------- gap and contact memory
+def one_node_case(rel_velocity_n, rel_velocity_t, prox, kappa=1.0e8, pressure=3.0e8):
+    """A single massive node just under the sphere; relative velocity given along n and one tangent."""
+    centre = ORIGIN + DX * np.array([5.0, 5.0, 9.0])
+    radius = 3.0 * DX
+    node = (5 * SHAPE[1] + 5) * SHAPE[2] + 6  # straight below the centre, on the sphere surface
+    n = np.array([0.0, 0.0, -1.0])
+    t = np.array([1.0, 0.0, 0.0])
+    v_sphere = np.array([0.1, 0.0, -0.01])
+    grid_m = np.zeros(N_NODES)
+    grid_m[node] = 1e-6
+    grid_v = np.zeros((N_NODES, 3))
+    grid_v[node] = v_sphere + rel_velocity_n * n + rel_velocity_t * t
+    cbuf = np.zeros((N_NODES, ct.N_CBUF))
+    cbuf[node, :3] = -pressure  # isotropic compression: P = pressure along any normal
+    cbuf[node, 6] = kappa
+    cbuf[node, 7] = 1.0
+    cbuf[node, 8] = prox
+    return dict(node=node, centre=centre, radius=radius, n=n, t=t, v_sphere=v_sphere, grid_m=grid_m, grid_v=grid_v,
+                cbuf=cbuf)
+
+
+def call_with_memory(c, fn_filtered, last_step, step, alpha, f=1.0):
+    grid_v = c["grid_v"].copy()
+    out = np.zeros(ct.N_OUT)
+    ct.sphere_contact(c["grid_m"], grid_v, c["cbuf"].copy(), NO_FLAGS, fn_filtered, last_step, step, alpha, ORIGIN,
+                      DX, SHAPE, c["centre"], c["radius"], c["v_sphere"], DT, ct.INTERFACE_PROPORTIONAL,
+                      np.array([f, 0.0]), out)
+    rel = grid_v[c["node"]] - c["v_sphere"]
+    return rel @ c["n"], rel @ c["t"], out
+
+
+def test_node_may_approach_by_its_closest_particles_gap():
+    gap = 0.3 * DX
+    # approaching at twice the speed that closes the gap in one step: held to closing it exactly
+    c = one_node_case(-2.0 * gap / DT, 0.0, prox=DX - gap)
+    vn, _, out = call_with_memory(c, *no_memory())
+    assert vn == pytest.approx(-gap / DT, rel=1e-12)
+    assert out[ct.OUT_FN + 2] == pytest.approx(c["grid_m"][c["node"]] * gap / DT / DT, rel=1e-12)
+    # approaching slower than that: free, no force
+    c = one_node_case(-0.5 * gap / DT, 0.0, prox=DX - gap)
+    vn, _, out = call_with_memory(c, *no_memory())
+    assert vn == pytest.approx(-0.5 * gap / DT, rel=1e-12)
+    assert out[ct.OUT_NODES] == 0 and np.all(out[ct.OUT_FN:ct.OUT_FN + 3] == 0.0)
+    # no particle within a cell of the sphere (proximity 0): never in contact
+    c = one_node_case(-10.0 * DX / DT, 0.0, prox=0.0)
+    vn, _, out = call_with_memory(c, *no_memory())
+    assert vn == pytest.approx(-10.0 * DX / DT) and out[ct.OUT_NODES] == 0
+
+
+def test_held_node_keeps_interface_shear_while_separating_and_is_released_when_its_force_fades():
+    kappa, pressure, alpha, step = 1.0e8, 3.0e8, 0.1, 7
+    slip = 100.0  # m/s: far more than the traction can stop in one step (DT is large)
+    c = one_node_case(+1e-3, slip, prox=DX)  # separating this step
+    node = c["node"]
+    m = c["grid_m"][node]
+    f0 = 0.5 * pressure * DX * DX  # filtered force of half a face at the contact pressure
+    fn = np.zeros(N_NODES)
+    last = np.full(N_NODES, -2, dtype=np.int64)
+    fn[node], last[node] = f0, step - 1
+    vn, vt, out = call_with_memory(c, fn, last, step, alpha)
+    f1 = (1.0 - alpha) * f0  # no normal impulse this step: the filter decays
+    area = f1 / pressure
+    assert vn == pytest.approx(1e-3, rel=1e-9)  # the normal velocity is left alone
+    assert m * (slip - vt) == pytest.approx(kappa * area * DT, rel=1e-9)  # tau = f kappa over the filtered area
+    assert fn[node] == pytest.approx(f1, rel=1e-12) and last[node] == step
+    assert out[ct.OUT_NODES] == 1 and np.all(out[ct.OUT_FN:ct.OUT_FN + 3] == 0.0)
+    # the same node not held on the previous step: separating, so no contact at all
+    fn[node], last[node] = f0, step - 2
+    vn, vt, out = call_with_memory(c, fn, last, step, alpha)
+    assert vt == pytest.approx(slip, rel=1e-12) and out[ct.OUT_NODES] == 0 and last[node] == step - 2
+    # held but with a faded force (area below RELEASE_AREA of a face): released, untouched
+    fn[node], last[node] = 0.5 * ct.RELEASE_AREA * pressure * DX * DX, step - 1
+    vn, vt, out = call_with_memory(c, fn, last, step, alpha)
+    assert vt == pytest.approx(slip, rel=1e-12) and out[ct.OUT_NODES] == 0 and last[node] == step - 1
+
+
+def test_filtered_force_follows_a_steady_push_and_smooths_a_bursty_one():
+    """Pushed every step by F the filter tends to F; pushed every other step by 2F it tends to ~F too."""
+    alpha = 0.05
+    weak = dict(kappa=1.0e3, pressure=2.0e3)  # the push spreads over half a face: held, not released
+    c = one_node_case(-1e-4, 0.0, prox=DX, **weak)
+    node = c["node"]
+    m = c["grid_m"][node]
+    push = m * 1e-4 / DT
+    fn = np.zeros(N_NODES)
+    last = np.full(N_NODES, -2, dtype=np.int64)
+    for step in range(400):
+        call_with_memory(c, fn, last, step, alpha)
+    assert fn[node] == pytest.approx(push, rel=1e-6)
+    bursty = one_node_case(-2e-4, 0.0, prox=DX, **weak)
+    resting = one_node_case(+1e-9, 0.0, prox=DX, **weak)
+    fn[:] = 0.0
+    last[:] = -2
+    history = []
+    for step in range(400):
+        call_with_memory(bursty if step % 2 == 0 else resting, fn, last, step, alpha)
+        history.append(fn[node])
+    assert last[node] == 399  # held throughout, also on the steps without a push
+    assert np.mean(history[-40:]) == pytest.approx(push, rel=0.05)
+    assert np.ptp(history[-40:]) < 0.25 * push

@@ -312,7 +312,7 @@ def contact_states(draw) -> dict:
     cbuf[:, 6] = wgt * kappa
     cbuf[:, 7] = wgt
     cbuf[rng.random(N_NODES) < 0.05, :8] = 0.0  # touching but without weight: pressure = kappa = 0
-    cbuf[:, 8] = rng.random(N_NODES) < 0.85
+    cbuf[:, 8] = DX * (rng.random(N_NODES) < 0.85)  # proximity DX - gap: 0 gap (touching) or no particle near
     if symmetric:
         flags = rng.choice(np.array([FREE, FIXED, MIRROR, GHOST], dtype=np.int8), N_NODES, p=[0.35, 0.1, 0.3, 0.25])
     else:
@@ -325,7 +325,8 @@ def call_contact(s: dict, grid_m=None, grid_v=None, cbuf=None):
     grid_v = (s["grid_v"] if grid_v is None else grid_v).copy()
     cbuf = (s["cbuf"] if cbuf is None else cbuf).copy()
     out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(s["grid_m"] if grid_m is None else grid_m, grid_v, cbuf, s["flags"], ORIGIN, DX, SHAPE,
+    memory = np.zeros(N_NODES), np.full(N_NODES, -2, dtype=np.int64), 0, 1.0  # first step: no node held
+    ct.sphere_contact(s["grid_m"] if grid_m is None else grid_m, grid_v, cbuf, s["flags"], *memory, ORIGIN, DX, SHAPE,
                       s["centre"], s["radius"], s["v_sphere"], s["dt"], s["model"], s["iparams"], out)
     return grid_v, out
 

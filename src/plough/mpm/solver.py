@@ -81,6 +81,7 @@ class Constants:
     slide_speed: float
     slide_distance: float
     control_gain: float  # m/s per N
+    contact_alpha: float  # weight of one step in the per-node contact-force filter
     filter_alpha: float
     control: str
     target_depth: float | None
@@ -99,6 +100,8 @@ class Work:
     grid_v: np.ndarray
     flags: np.ndarray
     cbuf: np.ndarray
+    fn_filtered: np.ndarray  # per-node filtered contact normal force, N
+    last_contact: np.ndarray  # per-node step of the last contact
     acc: np.ndarray
     contact_out: np.ndarray
     external_work: float = 0.0
@@ -165,6 +168,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         press_speed=scene.sliding.press_speed_fraction * scene.sliding.speed_m_s,
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
+        contact_alpha=min(dt / (contact.FILTER_WAVE_TIMES * dx / c), 1.0),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
         shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
@@ -173,7 +177,8 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
         grid_v=np.zeros((grid.n_nodes, 3)),
         flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
-        cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), acc=np.zeros((n_chunks, transfers.N_ACC)),
+        cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), fn_filtered=np.zeros(grid.n_nodes),
+        last_contact=np.full(grid.n_nodes, -2, dtype=np.int64), acc=np.zeros((n_chunks, transfers.N_ACC)),
         contact_out=np.zeros(contact.N_OUT),
     )
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
@@ -202,8 +207,9 @@ def step(s: State, c: Constants) -> None:
     contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
                                    p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
                                    w.cbuf)
-    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
-                           sph.velocity, c.dt, c.interface_model, c.interface_params, w.contact_out)
+    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, w.fn_filtered, w.last_contact, s.step, c.contact_alpha,
+                           g.origin, g.dx, c.shape, sph.centre, c.sphere_radius, sph.velocity, c.dt, c.interface_model,
+                           c.interface_params, w.contact_out)
     if c.mirror_j0 >= 0:
         transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0)
     move_sphere(sph, c)
