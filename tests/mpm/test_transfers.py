@@ -52,11 +52,11 @@ def p2g_update(x, v, C, stress, vol0, J, mass, dt, n_chunks=1, flags=None):
     buf = tr.allocate_grid_buffers(n_chunks, n_nodes)
     tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, dt, SHAPE, buf)
     grid_m = np.zeros(n_nodes)
-    grid_v = np.zeros((n_nodes, 3))
+    grid_v = np.zeros((n_nodes, 6))
     if flags is None:
         flags = np.full(n_nodes, FREE, dtype=np.int8)
     tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1)
-    return buf, grid_m, grid_v
+    return buf, grid_m, grid_v[:, :3].copy()  # the new velocity; columns 3:6 are tested on their own
 
 
 def random_sym_stress(rng, n, scale=1e8):
@@ -119,8 +119,10 @@ def test_apic_p2g_conserves_angular_momentum():
 
 # ----------------------------------------------------------------------------- affine field
 def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=None, sphere_r=1e-6,
-            near_dist=3 * DX, grid_lo=None, grid_hi=None, table=STIFF):
+            near_dist=3 * DX, grid_lo=None, grid_hi=None, table=STIFF, flip=0.0):
     n = x.shape[0]
+    if grid_v.shape[1] == 3:  # no FLIP increment: the old velocity equals the new one
+        grid_v = np.hstack([grid_v, grid_v])
     eps_p = np.zeros(n)
     temperature = np.full(n, 298.0)
     mat = np.zeros(n, dtype=np.int32)
@@ -132,7 +134,7 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     lo = ORIGIN + DX if grid_lo is None else grid_lo
     hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
     tr.g2p(grid_v, ORIGIN, DX, dt, SHAPE, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat, mat, frac,
-           table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi)
+           table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, flip)
     return acc, near, eps_p
 
 
@@ -310,24 +312,27 @@ def test_p2g_zeroes_stale_buffer():
 def test_grid_update_boundary_conditions():
     rng = np.random.default_rng(9)
     n_nodes = 500
-    buf = np.zeros((3, n_nodes, 4))
+    buf = np.zeros((3, n_nodes, 7))
     buf[:, :, 0] = rng.uniform(0.0, 1.0, (3, n_nodes))
-    buf[:, :, 1:] = rng.normal(0.0, 1.0, (3, n_nodes, 3))
+    buf[:, :, 1:] = rng.normal(0.0, 1.0, (3, n_nodes, 6))
     buf[:, :20, 0] = 0.0  # empty nodes
     flags = rng.choice(np.array([FREE, FIXED, MIRROR], dtype=np.int8), n_nodes)
     grid_m = np.full(n_nodes, -1.0)
-    grid_v = np.full((n_nodes, 3), 99.0)
+    grid_v = np.full((n_nodes, 6), 99.0)
     tr.grid_update(buf, flags, grid_m, grid_v, np.array([1, 1, n_nodes], dtype=np.int64), -1)
     m = buf[:, :, 0].sum(0)
-    mom = buf[:, :, 1:].sum(0)
+    mom = buf[:, :, 1:4].sum(0)
+    impulse = buf[:, :, 4:7].sum(0)
     np.testing.assert_allclose(grid_m, m, rtol=1e-15)
     empty = m <= 0
+    # the velocity before the internal force (for the FLIP increment) on every node with mass
+    np.testing.assert_allclose(grid_v[~empty, 3:], (mom - impulse)[~empty] / m[~empty, None], rtol=1e-12)
     free = (flags == FREE) & ~empty
     fixed = flags == FIXED
     mirror = (flags == MIRROR) & ~empty
     assert free.any() and fixed.any() and mirror.any() and empty.any()
-    np.testing.assert_allclose(grid_v[free], mom[free] / m[free, None], rtol=1e-14)
-    np.testing.assert_array_equal(grid_v[fixed], 0.0)
+    np.testing.assert_allclose(grid_v[free, :3], mom[free] / m[free, None], rtol=1e-14)
+    np.testing.assert_array_equal(grid_v[fixed, :3], 0.0)
     np.testing.assert_array_equal(grid_v[empty], 0.0)
     np.testing.assert_array_equal(grid_v[mirror, 1], 0.0)
     np.testing.assert_allclose(grid_v[mirror][:, [0, 2]], mom[mirror][:, [0, 2]] / m[mirror, None], rtol=1e-14)
@@ -368,7 +373,7 @@ def test_mirror_fold_reproduces_the_full_domain():
         tr.p2g(xs, vs, Cs, ss, np.tile(vol0, len(xs) // n), np.tile(J, len(xs) // n), np.tile(mass, len(xs) // n),
                grid.origin, dx, 1e-7, shape, buf)
         flags = boundary_flags(grid, 1.0, symmetric)  # radius 1 m: nothing fixed
-        gm, gv = np.zeros(grid.n_nodes), np.zeros((grid.n_nodes, 3))
+        gm, gv = np.zeros(grid.n_nodes), np.zeros((grid.n_nodes, 6))
         tr.grid_update(buf, flags, gm, gv, shape, mirror_plane_index(grid, symmetric))
         return gm, gv, flags
 
@@ -392,3 +397,41 @@ def test_mirror_fold_reproduces_the_full_domain():
             assert gm_h[i] == pytest.approx(gm_f[j], rel=1e-12)
             np.testing.assert_allclose(gv_h[i], gv_f[j], rtol=1e-9, atol=1e-12)
     assert checked > 100
+
+
+# ----------------------------------------------------------------------------- FLIP increment
+def test_p2g_keeps_the_internal_force_impulse_apart():
+    """Channels 4:7 hold the stress part of the momentum: with v = 0 and C = 0 they are all of it."""
+    rng, x, _, vol0, J, mass = random_particles(seed=21)
+    n = x.shape[0]
+    stress = random_sym_stress(rng, n)
+    buf, _, _ = p2g_update(x, np.zeros((n, 3)), np.zeros((n, 3, 3)), stress, vol0, J, mass, 1e-8)
+    np.testing.assert_allclose(buf[0, :, 4:7], buf[0, :, 1:4], rtol=0, atol=1e-14 * np.abs(buf[0, :, 1:4]).max())
+    assert np.abs(buf[0, :, 4:7]).max() > 0
+    # with velocities and no stress the impulse channels stay zero
+    v = rng.normal(0.0, 0.1, (n, 3))
+    buf, _, _ = p2g_update(x, v, np.zeros((n, 3, 3)), np.zeros((n, 6)), vol0, J, mass, 1e-8)
+    np.testing.assert_array_equal(buf[0, :, 4:7], 0.0)
+
+
+@pytest.mark.parametrize("flip", [0.0, 0.3, 1.0])
+def test_g2p_blends_the_flip_increment_with_the_grid_velocity(flip):
+    """v_p <- (1 - flip) sum w v_i + flip (v_p + sum w (v_i - v_i_old)); positions move with sum w v_i."""
+    rng, x, _, vol0, J, mass = random_particles(seed=22)
+    n = x.shape[0]
+    n_nodes = int(np.prod(SHAPE))
+    grid_v = np.zeros((n_nodes, 6))
+    grid_v[:, :3] = rng.normal(0.0, 0.1, (n_nodes, 3))  # new: random, not affine
+    delta = np.array([0.01, -0.02, 0.03])
+    grid_v[:, 3:] = grid_v[:, :3] - delta  # old: every node gained delta in this step
+    v_old = rng.normal(0.0, 0.1, (n, 3))
+    v = v_old.copy()
+    x0 = x.copy()
+    run_g2p(grid_v, x, v, np.zeros((n, 3, 3)), np.zeros((n, 6)), J, vol0, mass, 1e-7, flip=flip)
+    # the grid velocity at the particles, from a second gather with flip = 0
+    v_pic = np.zeros((n, 3))
+    run_g2p(grid_v, x0.copy(), v_pic, np.zeros((n, 3, 3)), np.zeros((n, 6)), J, vol0, mass, 1e-7)
+    np.testing.assert_allclose(v, (1 - flip) * v_pic + flip * (v_old + delta), rtol=0, atol=1e-15)
+    np.testing.assert_allclose(x, x0 + 1e-7 * v_pic, rtol=0, atol=1e-18)
+    if flip > 0:
+        assert np.abs(v - v_pic).max() > 1e-3  # the particles keep what the grid cannot hold

@@ -82,6 +82,7 @@ class Constants:
     slide_distance: float
     control_gain: float  # m/s per N
     contact_alpha: float  # weight of one step in the per-node contact-force filter
+    flip: float  # FLIP share of the particle velocity update (0 = APIC)
     filter_alpha: float
     control: str
     target_depth: float | None
@@ -168,14 +169,14 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         press_speed=scene.sliding.press_speed_fraction * scene.sliding.speed_m_s,
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
-        contact_alpha=min(dt / (contact.FILTER_WAVE_TIMES * dx / c), 1.0),
+        flip=disc.flip, contact_alpha=min(dt / (contact.FILTER_WAVE_TIMES * dx / c), 1.0),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
         shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
-        grid_v=np.zeros((grid.n_nodes, 3)),
+        grid_v=np.zeros((grid.n_nodes, 6)),
         flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
         cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), fn_filtered=np.zeros(grid.n_nodes),
         last_contact=np.full(grid.n_nodes, -2, dtype=np.int64), acc=np.zeros((n_chunks, transfers.N_ACC)),
@@ -215,7 +216,7 @@ def step(s: State, c: Constants) -> None:
     move_sphere(sph, c)
     transfers.g2p(w.grid_v, g.origin, g.dx, c.dt, c.shape, p.x, p.v, p.C, p.stress, p.J, p.vol0, p.mass, p.eps_p,
                   p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney, sph.centre,
-                  c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi)
+                  c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, c.flip)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)

@@ -7,8 +7,15 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
 - P2G (APIC with the MLS internal force, Hu et al. 2018):
       m_i  = sum_p w_ip m_p
       (mv)_i = sum_p w_ip [m_p v_p + (m_p C_p - dt V_p D^-1 sigma_p)(x_i - x_p)],  D^-1 = 4/dx^2
-- G2P: v_p = sum_i w_ip v_i,  C_p = D^-1 sum_i w_ip v_i (x_i - x_p)^T  (= velocity gradient L_p),
-      J_p <- J_p det(I + dt L_p),  x_p <- x_p + dt v_p.
+- G2P: v_p <- (1 - flip) sum_i w_ip v_i + flip (v_p + sum_i w_ip (v_i - v_i^old)),
+      C_p = D^-1 sum_i w_ip v_i (x_i - x_p)^T  (= velocity gradient L_p),
+      J_p <- J_p det(I + dt L_p),  x_p <- x_p + dt sum_i w_ip v_i,
+  with v_i^old the nodal velocity before the internal force, boundary conditions and contact.
+  flip = 0 is APIC. APIC drops the part of the velocity field an affine field cannot hold on
+  every transfer: a numerical dissipation per step, so the more steps a slide takes the more of
+  the sphere's work it eats (41% at CFL 0.075 on the frictionless reference scene) and the
+  results followed the time step. The FLIP increment keeps that part; positions move with the
+  grid velocity, so the particles do not drift apart.
 
 Threads: particles are cut into ``n_chunks`` contiguous chunks (in seeding order, so a chunk is a
 slab of the block). The scatter is race-free by construction: chunk c writes only its own grid
@@ -44,8 +51,9 @@ BAD_NONE, BAD_LEFT_GRID, BAD_J, BAD_NONFINITE = 0, 1, 2, 3
 def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf):
     """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
 
-    Reads x, v, C, stress, vol0, J, mass (particles). Writes grid_buf[c, node, 0:4] = (mass,
-    momentum x, y, z) of chunk c, zeroing it first. Race-free: chunk c owns grid_buf[c].
+    Reads x, v, C, stress, vol0, J, mass (particles). Writes grid_buf[c, node, 0:7] = (mass,
+    momentum x, y, z, and the internal-force impulse x, y, z already in that momentum) of chunk
+    c, zeroing it first. Race-free: chunk c owns grid_buf[c].
     """
     n = x.shape[0]
     n_chunks = grid_buf.shape[0]
@@ -91,6 +99,9 @@ def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf):
                         buf[node, 1] += w * (mv0 + q00 * d0 + q01 * d1 + q02 * d2)
                         buf[node, 2] += w * (mv1 + q10 * d0 + q11 * d1 + q12 * d2)
                         buf[node, 3] += w * (mv2 + q20 * d0 + q21 * d1 + q22 * d2)
+                        buf[node, 4] += w * k_stress * (s[0] * d0 + s[5] * d1 + s[4] * d2)
+                        buf[node, 5] += w * k_stress * (s[5] * d0 + s[1] * d1 + s[3] * d2)
+                        buf[node, 6] += w * k_stress * (s[4] * d0 + s[3] * d1 + s[2] * d2)
 
 
 @njit(cache=True, parallel=True)
@@ -98,8 +109,9 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
     """Sum the chunk copies into nodal mass and velocity and apply the boundary conditions.
 
     Reads grid_buf (P2G output), flags (FREE / FIXED / MIRROR / GHOST), the grid shape and the
-    index ``mirror_j0`` of the node plane y = 0 (-1 without symmetry). Writes grid_m[node] and
-    grid_v[node, 0:3] (velocity at the end of the step before contact). Each node is owned by
+    index ``mirror_j0`` of the node plane y = 0 (-1 without symmetry). Writes grid_m[node],
+    grid_v[node, 0:3] (velocity at the end of the step before contact) and grid_v[node, 3:6]
+    (velocity before the internal force, for the FLIP increment). Each node is owned by
     one iteration and only reads the buffers, so the reduction is race-free.
 
     Mirror symmetry is exact, not just v_y = 0 on the plane: a node at y = +j dx also receives
@@ -115,11 +127,17 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
         p0 = 0.0
         p1 = 0.0
         p2 = 0.0
+        i0 = 0.0
+        i1 = 0.0
+        i2 = 0.0
         for c in range(n_chunks):
             m += grid_buf[c, node, 0]
             p0 += grid_buf[c, node, 1]
             p1 += grid_buf[c, node, 2]
             p2 += grid_buf[c, node, 3]
+            i0 += grid_buf[c, node, 4]
+            i1 += grid_buf[c, node, 5]
+            i2 += grid_buf[c, node, 6]
         if mirror_j0 >= 0:
             j = (node // nz) % ny
             jm = 2 * mirror_j0 - j
@@ -130,7 +148,18 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
                     p0 += grid_buf[c, partner, 1]
                     p1 -= grid_buf[c, partner, 2]
                     p2 += grid_buf[c, partner, 3]
+                    i0 += grid_buf[c, partner, 4]
+                    i1 -= grid_buf[c, partner, 5]
+                    i2 += grid_buf[c, partner, 6]
         grid_m[node] = m
+        if m > 0.0:
+            grid_v[node, 3] = (p0 - i0) / m
+            grid_v[node, 4] = (p1 - i1) / m
+            grid_v[node, 5] = (p2 - i2) / m
+        else:
+            grid_v[node, 3] = 0.0
+            grid_v[node, 4] = 0.0
+            grid_v[node, 5] = 0.0
         if m <= 0.0 or flags[node] == FIXED:
             grid_v[node, 0] = 0.0
             grid_v[node, 1] = 0.0
@@ -163,10 +192,11 @@ def mirror_ghosts(grid_v, flags, shape, mirror_j0):
 
 @njit(cache=True, parallel=True)
 def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat_a, mat_b,
-        frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo, grid_hi):
+        frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo, grid_hi, flip):
     """Gather velocities, update stress (eq. 6.1-6.2), advect, and check the particle state.
 
-    Reads grid_v, the sphere (centre sphere_c after this step, radius sphere_r). Writes particle
+    Reads grid_v (0:3 new, 3:6 before the internal force), the particle velocity v (FLIP
+    share ``flip``), the sphere (centre sphere_c after this step, radius sphere_r). Writes particle
     v, C, J, x, stress, eps_p, temperature, near (1 if within near_dist of the sphere surface),
     and per-chunk accumulators acc[c, :] (plastic work, kinetic and elastic energy, adiabatic
     heat, deepest penetration of a particle centre into the sphere, worst instability code and
@@ -195,6 +225,9 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
             v0 = 0.0
             v1 = 0.0
             v2 = 0.0
+            dv0 = 0.0
+            dv1 = 0.0
+            dv2 = 0.0
             b00 = 0.0
             b01 = 0.0
             b02 = 0.0
@@ -221,6 +254,9 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
                         v0 += gv0
                         v1 += gv1
                         v2 += gv2
+                        dv0 += w * (grid_v[node, 0] - grid_v[node, 3])
+                        dv1 += w * (grid_v[node, 1] - grid_v[node, 4])
+                        dv2 += w * (grid_v[node, 2] - grid_v[node, 5])
                         b00 += gv0 * d0
                         b01 += gv0 * d1
                         b02 += gv0 * d2
@@ -230,9 +266,9 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
                         b20 += gv2 * d0
                         b21 += gv2 * d1
                         b22 += gv2 * d2
-            v[p, 0] = v0
-            v[p, 1] = v1
-            v[p, 2] = v2
+            v[p, 0] = (1.0 - flip) * v0 + flip * (v[p, 0] + dv0)
+            v[p, 1] = (1.0 - flip) * v1 + flip * (v[p, 1] + dv1)
+            v[p, 2] = (1.0 - flip) * v2 + flip * (v[p, 2] + dv2)
             Cp = C[p]
             Cp[0, 0] = dinv * b00
             Cp[0, 1] = dinv * b01
@@ -254,7 +290,7 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
             heat_sum += taylor_quinney * w_pl * vol
             K, G = mixed_moduli(pa, pb, frac_a[p])
             el_sum += elastic_energy_density(stress, p, K, G) * vol
-            ke_sum += 0.5 * mass[p] * (v0 * v0 + v1 * v1 + v2 * v2)
+            ke_sum += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
             x0 = x[p, 0] + dt * v0
             x1 = x[p, 1] + dt * v1
             x2 = x[p, 2] + dt * v2
@@ -305,4 +341,4 @@ def _det_i_plus(dt, L):
 
 
 def allocate_grid_buffers(n_chunks: int, n_nodes: int) -> np.ndarray:
-    return np.zeros((n_chunks, n_nodes, 4))
+    return np.zeros((n_chunks, n_nodes, 7))
