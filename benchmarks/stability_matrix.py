@@ -1,4 +1,4 @@
-"""Stability stress matrix (preliminary, issue 5): extreme numerical settings and scenes on a small
+"""Stability stress matrix (issue 5): extreme numerical settings and scenes on a small
 rigid-plastic scene (r = 0.2 mm, 1 N, h = 10 um, 0.2 mm slide, sized block).
 
     python benchmarks/stability_matrix.py
@@ -52,9 +52,9 @@ CASES = {
     "mass scaling 1e8": variant(**{"discretisation.mass_scaling": 1e8}),
     "mass scaling 1e9": variant(**{"discretisation.mass_scaling": 1e9}),
     "speed 1 m/s": variant(**{"sliding.speed_m_s": 1.0}),
-    "H~ = 0.1 coating, t = 25 um": variant(**{"layers": {"coating_thickness_um": 25,
-                                                           "coating": {"rigid_plastic_hardness_MPa": 90},
-                                                           "substrate": {"rigid_plastic_hardness_MPa": 900}}}),
+    "H~ = 0.1 coating, t = 25 um, 0.3 mm slide": variant(**{
+        "layers": {"coating_thickness_um": 25, "coating": {"rigid_plastic_hardness_MPa": 90},
+                   "substrate": {"rigid_plastic_hardness_MPa": 900}}, "sliding.distance_um": 300}),
     "t = 200 um (bulk coating)": variant(**{"layers": {"coating_thickness_um": 200,
                                                          "coating": {"rigid_plastic_hardness_MPa": 450},
                                                          "substrate": {"rigid_plastic_hardness_MPa": 900}}}),

@@ -20,6 +20,7 @@ import yaml
 
 from plough import cli
 from plough.mpm import contact, solver, transfers
+from plough.mpm import scene as scene_module
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
@@ -198,8 +199,19 @@ def test_non_finite_particle_during_sliding_stops_the_run(tiny_state):
     assert "non-finite" in msg
 
 
-def test_inertia_dominated_scene_raises_simulation_error():
-    scene = Scene.from_dict(scene_dict(**UNSTABLE))  # passes validation
+@pytest.fixture()
+def allow_inertia(monkeypatch):
+    """Lift the inertia-number refusal so that the run-time guards behind it can be tested."""
+    monkeypatch.setattr(scene_module, "INERTIA_MAX", math.inf)
+
+
+def test_inertia_dominated_scene_is_refused_before_running():
+    with pytest.raises(ValueError, match=r"inertia number ms rho v\^2 / H = .* above the allowed"):
+        Scene.from_dict(scene_dict(**UNSTABLE))
+
+
+def test_inertia_dominated_scene_raises_simulation_error(allow_inertia):
+    scene = Scene.from_dict(scene_dict(**UNSTABLE))  # passes validation with the refusal lifted
     # either the kinetic-energy / state checks stop it, or the sphere flies off and the run ends
     # with the lost-contact error: both name inertia as the cause
     with pytest.raises(solver.SimulationError,
@@ -207,7 +219,7 @@ def test_inertia_dominated_scene_raises_simulation_error():
         simulate(scene, progress=False, threads=1)
 
 
-def test_lost_contact_while_sliding_is_an_error():
+def test_lost_contact_while_sliding_is_an_error(allow_inertia):
     scene = Scene.from_dict(scene_dict(sliding={"distance_um": 200, "speed_m_s": 200.0}))
     with pytest.raises(solver.SimulationError):
         with np.errstate(invalid="ignore"):
@@ -261,7 +273,7 @@ def test_cli_bad_scene_exits_2_and_writes_nothing(tmp_path, capsys):
     assert not out.exists()
 
 
-def test_cli_unstable_run_exits_2_without_traceback(tmp_path, capsys):
+def test_cli_unstable_run_exits_2_without_traceback(tmp_path, capsys, allow_inertia):
     scene_file = tmp_path / "unstable.yaml"
     scene_file.write_text(yaml.safe_dump(scene_dict(**UNSTABLE)))
     out = tmp_path / "unstable.nc"

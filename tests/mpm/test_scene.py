@@ -134,6 +134,9 @@ BAD = {
     "not a number": (_mutate(discretisation__cfl="abc"), r"discretisation\.cfl"),
     "particles too coarse": (_mutate(discretisation__particle_size_um=60), r"discretisation\.particle_size_m"),
     "mass scaling below 1": (_mutate(discretisation__mass_scaling=0.5), r"discretisation\.mass_scaling"),
+    "flip above 1": (_mutate(discretisation__flip=1.5), r"discretisation\.flip.*\[0, 1\]"),
+    "inertia dominates": (_mutate(discretisation__mass_scaling=1e8),
+                          r"discretisation\.mass_scaling.*speed_m_s.*inertia number .* = 8\.72 above the allowed 4"),
     "unknown control": (_mutate(sliding__control="force"), r"sliding\.control"),
     "displacement without depth": (_mutate(sliding__control="displacement"), r"sliding\.depth_m"),
     "unknown interface model": (_mutate(interface={"model": "magic"}), r"interface\.model"),
@@ -292,3 +295,10 @@ def test_interface_default_and_expected_contact():
     assert s.interface == ProportionalShear(f=1.0)
     a, dp = s.expected_contact()
     assert 0 < dp < a < s.sphere.radius_m
+
+
+def test_inertia_number_of_the_reference_scene():
+    """ms rho v^2 / H: 1e6 x 7850 kg/m^3 x (0.1 m/s)^2 / 900 MPa (the README's 0.087)."""
+    s = Scene.from_dict(example_dict())
+    assert s.inertia_number == pytest.approx(1e6 * s.layers.substrate.density_kg_m3 * 0.01 / 900e6, rel=1e-12)
+    assert 0.08 < s.inertia_number < 0.09

@@ -30,10 +30,11 @@ Why the filter: the explicit normal projection acts on a node only on the steps 
 the sphere, and the contact rings at the elastic-wave period (on the reference scene no node
 approaches on 16% of the steps at CFL 0.3, 27% at CFL 0.15). An area taken from one step's
 impulse then switches between 0 and the face cap, and the mean shear force followed the time
-step (mu_sh 0.189 at CFL 0.3, 0.134 at CFL 0.15). The real contact does not open and close at
-that period, so a node in persistent contact (pushed on the previous step, or held since with a
-filtered area of at least RELEASE_AREA of a cell face) carries interface shear on every step,
-over the area of its filtered normal force; a held node that separates keeps its normal velocity.
+step (mu_sh 0.189 at CFL 0.3, 0.134 at CFL 0.15, with the APIC transfer of the time). The real
+contact does not open and close at that period, so a node in persistent contact (pushed on the
+previous step, or held since with a filtered area of at least RELEASE_AREA of a cell face)
+carries interface shear on every step, over the area of its filtered normal force; a held node
+that separates keeps its normal velocity.
 """
 
 from __future__ import annotations

@@ -1,0 +1,85 @@
+"""Stability stress tests (issue 5): extreme settings complete with bounded results or are refused.
+
+The small scene of ``benchmarks/stability_matrix.py`` (r = 0.2 mm, 1 N, h = 10 um, sized block).
+A completed run must give finite, physically bounded results: mu between 0.05 and 1.5, the mean
+normal force within 20% of the load, no particle centre inside the sphere, and (where the
+README documents that it holds) the energy terms within 15% of the sphere's work. The bounds are
+sanity bounds, not accuracy claims; the measured values are in the README's stability table.
+"""
+
+from __future__ import annotations
+
+import copy
+
+import numba
+import numpy as np
+import pytest
+
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+
+pytestmark = pytest.mark.slow
+
+BASE = {
+    "name": "stability", "load_N": 1.0, "sphere": {"radius_um": 200},
+    "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
+    "interface": {"model": "proportional", "f": 1.0},
+    "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
+    "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
+    "outputs": {"steady_window": [0.5, 1.0], "records": 40},
+}
+ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss")
+
+
+def scene(**parts) -> Scene:
+    d = copy.deepcopy(BASE)
+    for key, value in parts.items():
+        d[key] = {**d[key], **value} if isinstance(d.get(key), dict) else value
+    return Scene.from_dict(d).with_sized_domain()
+
+
+@pytest.fixture(scope="module", autouse=True)
+def two_threads():
+    old = numba.get_num_threads()
+    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
+    yield
+    numba.set_num_threads(old)
+
+
+def assert_bounded(s: Scene, *, energy: bool) -> None:
+    ds = simulate(s, progress=False)
+    for name in ("mu", "mu_pl", "mu_sh", "dp", "Fz_mean"):
+        assert np.isfinite(float(ds[name])), name
+    assert 0.05 < float(ds.mu) < 1.5
+    assert float(ds.Fz_mean) == pytest.approx(s.load_N, rel=0.20)
+    assert float(ds.max_particle_penetration) < 0.0  # particle centres stay outside the sphere
+    if energy:
+        ratio = sum(float(ds[k][-1]) for k in ENERGY_TERMS) / float(ds.external_work[-1])
+        assert ratio == pytest.approx(1.0, abs=0.15)
+
+
+def test_cfl_at_the_accepted_maximum_completes_bounded():
+    """CFL 1.0: stable (measured mu 0.524, Fz / load 1.15, energy 1.13 against 0.571 / 0.95 / 0.96 at 0.3)."""
+    assert_bounded(scene(discretisation={"cfl": 1.0}), energy=True)
+
+
+def test_bulk_coating_200_um_completes_bounded():
+    """t = 200 um, H~ = 0.5: the sphere never reaches the substrate (measured mu 0.448, energy 1.02)."""
+    assert_bounded(scene(layers={"coating_thickness_um": 200, "coating": {"rigid_plastic_hardness_MPa": 450},
+                                 "substrate": {"rigid_plastic_hardness_MPa": 900}}), energy=True)
+
+
+def test_soft_coating_h_tilde_0_1_completes_bounded():
+    """H~ = 0.1 (90 MPa on 900 MPa), t = 25 um: the coating is ploughed through (inertia number 0.87)."""
+    s = scene(layers={"coating_thickness_um": 25, "coating": {"rigid_plastic_hardness_MPa": 90},
+                      "substrate": {"rigid_plastic_hardness_MPa": 900}}, sliding={"distance_um": 300})
+    assert s.inertia_number < 1.0
+    assert_bounded(s, energy=False)
+
+
+@pytest.mark.parametrize("parts", [{"discretisation": {"mass_scaling": 1e8}}, {"sliding": {"speed_m_s": 1.0}}],
+                         ids=["mass scaling 1e8", "speed 1 m/s"])
+def test_inertia_dominated_settings_are_refused_before_running(parts):
+    """Inertia number 8.7: the run completed with a mean force twice the load; now refused."""
+    with pytest.raises(ValueError, match=r"inertia number .* above the allowed"):
+        scene(**parts)
