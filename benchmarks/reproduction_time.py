@@ -4,7 +4,7 @@
 
 Counts the particles and steps of every MPM run of the config (plough.study.cost, within a few
 per cent of the solver's counts) and divides by the particle-steps per second measured on the
-reference scene at 2 threads (benchmarks/results/mpm_reference.json, the slowest of its sizes).
+reference scene at 2 threads (benchmarks/results/mpm_reference_sized.json, the slowest of its sizes).
 With `--cores 2` and 2 threads per run the runs go one after another, so the total is their sum.
 Writes benchmarks/results/reproduction_time.json and prints a Markdown table.
 """
@@ -26,7 +26,7 @@ ROOT = Path(__file__).resolve().parents[1]
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
-    parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference.json"))
+    parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
     args = parser.parse_args()
     config = yaml.safe_load(Path(args.config).read_text())
