@@ -15,20 +15,14 @@ import json
 from pathlib import Path
 
 import numba
+import yaml
 
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 from plough.mpm.solver import SimulationError
 
 ROOT = Path(__file__).resolve().parents[1]
-BASE = {
-    "name": "stability", "load_N": 1.0, "sphere": {"radius_um": 200},
-    "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
-    "interface": {"model": "proportional", "f": 1.0},
-    "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
-    "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
-    "outputs": {"steady_window": [0.5, 1.0], "records": 40},
-}
+BASE = yaml.safe_load((ROOT / "examples" / "stability_small.yaml").read_text())
 ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss")
 
 

@@ -1,6 +1,7 @@
 """Stability stress tests (issue 5): extreme settings complete with bounded results or are refused.
 
-The small scene of ``benchmarks/stability_matrix.py`` (r = 0.2 mm, 1 N, h = 10 um, sized block).
+The small scene of ``benchmarks/stability_matrix.py`` (``examples/stability_small.yaml``: r = 0.2 mm,
+1 N, h = 10 um, sized block).
 A completed run must give finite, physically bounded results: mu between 0.05 and 1.5, the mean
 normal force within 20% of the load, no particle centre inside the sphere, and (where the
 README documents that it holds) the energy terms within 15% of the sphere's work. The bounds are
@@ -10,24 +11,18 @@ sanity bounds, not accuracy claims; the measured values are in the README's stab
 from __future__ import annotations
 
 import copy
+from pathlib import Path
 
-import numba
 import numpy as np
 import pytest
+import yaml
 
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.usefixtures("two_threads")]
 
-BASE = {
-    "name": "stability", "load_N": 1.0, "sphere": {"radius_um": 200},
-    "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
-    "interface": {"model": "proportional", "f": 1.0},
-    "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
-    "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
-    "outputs": {"steady_window": [0.5, 1.0], "records": 40},
-}
+BASE = yaml.safe_load((Path(__file__).resolve().parents[2] / "examples" / "stability_small.yaml").read_text())
 ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss")
 
 
@@ -36,14 +31,6 @@ def scene(**parts) -> Scene:
     for key, value in parts.items():
         d[key] = {**d[key], **value} if isinstance(d.get(key), dict) else value
     return Scene.from_dict(d).with_sized_domain()
-
-
-@pytest.fixture(scope="module", autouse=True)
-def two_threads():
-    old = numba.get_num_threads()
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    yield
-    numba.set_num_threads(old)
 
 
 def assert_bounded(s: Scene, *, energy: bool) -> None:

@@ -5,7 +5,6 @@ Slow runs (a few seconds to ~20 s each); the numbers they check are reported in 
 
 from __future__ import annotations
 
-import numba
 import numpy as np
 import pytest
 
@@ -13,17 +12,9 @@ from plough.mpm import contact, solver
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
-pytestmark = pytest.mark.slow
+pytestmark = [pytest.mark.slow, pytest.mark.usefixtures("two_threads")]
 
 R_M, E_PA, NU = 200e-6, 210e9, 0.3
-
-
-@pytest.fixture(scope="module", autouse=True)
-def two_threads():
-    old = numba.get_num_threads()
-    numba.set_num_threads(min(2, numba.config.NUMBA_NUM_THREADS))
-    yield
-    numba.set_num_threads(old)
 
 
 def indentation_force(h_um: float, depth_um: float, domain_um: float = 240.0) -> float:
