@@ -20,6 +20,7 @@ import yaml
 
 from plough import cli
 from plough.mpm import contact, solver, transfers
+from plough.mpm import run as run_module
 from plough.mpm import scene as scene_module
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
@@ -243,6 +244,36 @@ def test_sphere_stays_in_contact_while_sliding(tiny_scene):
     fz, vz = np.array(fz), np.array(vz)
     assert np.mean(fz > 0) > 0.5
     assert np.std(vz) < 0.1 * const.press_speed
+
+
+def test_stop_when_steady_ends_the_slide_early_and_says_so():
+    """A loose tolerance stops the tiny scene's slide early; the outputs refer to the distance slid."""
+    d = scene_dict()
+    d["sliding"] = {**d["sliding"], "stop_when_steady": True, "steady_tolerance": 0.2}
+    scene = Scene.from_dict(d)
+    ds = simulate(scene, progress=False, threads=1)
+    slid = ds.attrs["slid_distance_m"]
+    assert ds.attrs["stopped_when_steady"] == 1
+    assert run_module.SteadyStop(scene).minimum <= slid < scene.sliding.distance_m
+    assert float(ds.sliding_distance.max()) <= slid + 1e-12
+    window = ds.sliding_distance[ds.in_steady_window]
+    assert window.size >= 3 and float(window.min()) >= 0.5 * slid - 1e-12
+    for name in ("mu", "dp", "Fz_mean"):
+        assert np.isfinite(float(ds[name]))
+
+
+def test_steady_stop_waits_for_three_agreeing_checks():
+    scene = Scene.from_dict(TINY)
+    stop = run_module.SteadyStop(scene)
+
+    class Rec:  # records every 2 um with a constant mu of 0.5 after the first 30 um
+        slid = list(np.arange(0.0, 200e-6, 2e-6))
+        rows = [{"Fx": 0.5 if s > 30e-6 else 0.1, "Fz": 1.0} for s in slid]
+
+    decisions = [(x, stop.steady(Rec, x)) for x in np.arange(1e-6, 200e-6, 1e-6)]
+    first = next(x for x, yes in decisions if yes)
+    assert first >= stop.minimum
+    assert len(stop.history) >= 3 and stop.history[-1] == pytest.approx(0.5)
 
 
 # ----------------------------------------------------------------------------- command line

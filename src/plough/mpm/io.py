@@ -56,9 +56,10 @@ STEADY_META = {
 }
 
 
-def steady_window_mask(slid_m: np.ndarray, scene: Scene) -> np.ndarray:
+def steady_window_mask(slid_m: np.ndarray, scene: Scene, distance_m: float | None = None) -> np.ndarray:
+    """Records in the steady window: the window's fractions of the distance slid (default: the scene's)."""
     lo, hi = scene.outputs.steady_window
-    d = scene.sliding.distance_m
+    d = scene.sliding.distance_m if distance_m is None else distance_m
     # the run stops on the first step past the distance, so the last record may overshoot it by v dt
     tol = d / scene.outputs.records
     return (slid_m >= lo * d - 1e-12) & (slid_m <= hi * d + tol)
@@ -71,11 +72,12 @@ def _y_edges(scene: Scene) -> np.ndarray:
     return np.arange(0.0 if scene.domain.symmetric else -y_max, y_max + 0.5 * h, h)
 
 
-def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float) -> tuple:
+def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float,
+                      distance_m: float | None = None) -> tuple:
     """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
     h = scene.discretisation.particle_size_m
     x0 = scene.start_x_m
-    d = scene.sliding.distance_m
+    d = scene.sliding.distance_m if distance_m is None else distance_m
     lo, _ = scene.outputs.steady_window
     # sections where the sphere has passed and the material has unloaded: 1.25 contact radii behind
     # the sphere's final centre (a quarter radius behind the trailing edge), inside the steady window,
@@ -169,9 +171,14 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
 
 def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarray, p: Particles,
                   sphere_centre: np.ndarray, cost: dict[str, float], max_penetration: float,
-                  coating_row: int = -1) -> xr.Dataset:
-    """The results of one run as an xarray Dataset with units, long names and provenance."""
-    mask = steady_window_mask(slid_m, scene)
+                  coating_row: int = -1, slid_distance_m: float | None = None) -> xr.Dataset:
+    """The results of one run as an xarray Dataset with units, long names and provenance.
+
+    ``slid_distance_m`` is the distance actually slid when the run stopped early (stop_when_steady);
+    the steady window and the residual sections then refer to it.
+    """
+    slid_total = scene.sliding.distance_m if slid_distance_m is None else slid_distance_m
+    mask = steady_window_mask(slid_m, scene, slid_total)
     if mask.sum() < 3:
         raise ValueError("fewer than 3 records in the steady window; raise outputs.records")
     Fx, Fz = series["Fx"][mask].mean(), series["Fz"][mask].mean()
@@ -181,7 +188,7 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         raise SimulationError(f"the sphere lost contact while sliding (mean Fz = {Fz:.3g} N for load_N = "
                               f"{scene.load_N:g} N): inertia dominates; lower sliding.speed_m_s or mass_scaling")
     a_exp, _ = scene.expected_contact()
-    y, z_top, sections = residual_profiles(p, scene, float(sphere_centre[0]), a_exp)
+    y, z_top, sections = residual_profiles(p, scene, float(sphere_centre[0]), a_exp, slid_total)
     near_track = np.abs(y) <= 1.5 * a_exp
     dg = float(max(-np.nanmin(z_top[near_track]), 0.0))
     hpu = float(max(np.nanmax(z_top), 0.0))
@@ -213,6 +220,8 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         ds.attrs[f"cost_{name}"] = value
     ds.attrs.update(provenance_attrs(scene.to_dict(), key="scene"))
     ds.attrs["steady_window"] = json.dumps(list(scene.outputs.steady_window))
+    ds.attrs["slid_distance_m"] = float(slid_total)
+    ds.attrs["stopped_when_steady"] = int(slid_total < scene.sliding.distance_m)
     ds.attrs["coating_representation"] = coating_representation(scene)
     return ds
 

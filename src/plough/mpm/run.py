@@ -65,6 +65,44 @@ class _Recorder:
         return {k: np.array([r[k] for r in self.rows]) for k in keys}, np.array(self.slid)
 
 
+class SteadyStop:
+    """Ends the slide once the steady-state friction has stopped changing (``sliding.stop_when_steady``).
+
+    Every tenth of ``sliding.distance_m`` (after at least 2.7 expected contact radii and a third of
+    the distance, so that a residual groove is left behind the sphere), mu is taken over the steady
+    window as the same fractions of the distance slid so far. The slide stops when the last three
+    such values differ by less than ``sliding.steady_tolerance`` of their mean.
+    """
+
+    CHECKS = 10
+
+    def __init__(self, scene: Scene) -> None:
+        a, _ = scene.expected_contact()
+        self.window = scene.outputs.steady_window
+        self.tolerance = scene.sliding.steady_tolerance
+        self.every = scene.sliding.distance_m / self.CHECKS
+        self.minimum = max(2.7 * a / (1.0 - self.window[0]), scene.sliding.distance_m / 3.0)
+        self.next_check = self.every
+        self.history: list[float] = []
+
+    def steady(self, rec: _Recorder, slid_m: float) -> bool:
+        """Whether the slide may stop at ``slid_m`` (call once per step while sliding)."""
+        if slid_m < self.next_check or not rec.rows:
+            return False
+        self.next_check += self.every
+        slid = np.array(rec.slid)
+        lo, hi = self.window
+        mask = (slid >= lo * slid_m) & (slid <= hi * slid_m)
+        if mask.sum() < 3:
+            return False
+        fx = np.array([r["Fx"] for r in rec.rows])[mask].mean()
+        fz = np.array([r["Fz"] for r in rec.rows])[mask].mean()
+        self.history.append(fx / fz)
+        last = self.history[-3:]
+        return (slid_m >= self.minimum and len(last) == 3
+                and max(last) - min(last) <= self.tolerance * abs(float(np.mean(last))))
+
+
 def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path | None = None,
              threads: int | None = None) -> xr.Dataset:
     """Run the MPM ploughing simulation of ``scene`` and return its results dataset."""
@@ -79,10 +117,16 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     next_snap = 0.0
     coating_row = 0 if scene.layers.coated else -1
     bar = _progress(scene, enabled=progress)
+    stopper = SteadyStop(scene) if scene.sliding.stop_when_steady else None
+    slid_distance = scene.sliding.distance_m
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
             rec.add(state, const)
+            if stopper is not None and state.sphere.phase == "slide" and stopper.steady(rec, state.sphere.slid_m):
+                slid_distance = state.sphere.slid_m
+                state.sphere.phase = "done"
+                state.sphere.velocity[:] = 0.0
             if state.sphere.phase in ("press", "settle") and state.step > max_press_steps:
                 raise solver.SimulationError(
                     f"the sphere did not reach the load in {state.step} steps: load_N = {scene.load_N:g} N may be "
@@ -107,7 +151,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
             "dt_s": const.dt, "particle_steps_per_s": n * state.step / wall, "threads": numba.get_num_threads()}
     return io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
-                            rec.max_penetration, coating_row)
+                            rec.max_penetration, coating_row, slid_distance_m=slid_distance)
 
 
 def _progress(scene: Scene, enabled: bool):

@@ -158,7 +158,10 @@ class Sliding:
     ``speed_m_s`` is the simulated sliding speed; ``experiment_speed_m_s`` the physical one, used
     to evaluate strain-rate terms at the physical rate (rate_phys = rate_sim * v_exp / v_sim).
     ``control`` is ``load`` (the sphere's height floats so that Fz = load) or ``displacement``
-    (the sphere is held at ``depth_m`` below the original surface).
+    (the sphere is held at ``depth_m`` below the original surface). With ``stop_when_steady`` the
+    slide ends before ``distance_m`` once mu over the steady window (the same fractions of the
+    distance slid so far) has changed by less than ``steady_tolerance`` (relative) over the last
+    three checks, a tenth of ``distance_m`` apart (see ``plough.mpm.run.SteadyStop``).
     """
 
     distance_m: float = 600e-6
@@ -167,9 +170,16 @@ class Sliding:
     control: str = "load"
     depth_m: float | None = None
     press_speed_fraction: float = 0.25
+    stop_when_steady: bool = False
+    steady_tolerance: float = 0.01
 
     def __post_init__(self) -> None:
         _finite_positive("sliding", "distance_m", self.distance_m, "m")
+        if not isinstance(self.stop_when_steady, bool):
+            raise ValueError(f"sliding.stop_when_steady = {self.stop_when_steady!r} must be true or false")
+        if not (0.0 < self.steady_tolerance <= 0.2):
+            raise ValueError(f"sliding.steady_tolerance = {self.steady_tolerance!r} is outside the allowed "
+                             "range (0, 0.2]")
         _finite_positive("sliding", "speed_m_s", self.speed_m_s, "m/s")
         _finite_positive("sliding", "experiment_speed_m_s", self.experiment_speed_m_s, "m/s")
         if self.control not in ("load", "displacement"):
