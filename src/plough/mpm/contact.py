@@ -62,10 +62,7 @@ OUT_IMPACT = 7  # kinetic energy lost by the inelastic normal projection, J
 OUT_WORK = 8  # work done by the sphere on the material this step, J
 OUT_NODES = 9  # number of contact nodes
 OUT_AREA_XY = 10  # contact area projected on the xy plane, m^2
-OUT_CAPPED = 11  # contact nodes whose shear area hit the cell-face cap
-OUT_STICK = 12  # contact nodes where the slip was stopped (stick)
-OUT_AREA = 13  # sum of the nodes' shear areas, m^2
-N_OUT = 14
+N_OUT = 11
 #: channels of the contact scratch: 6 stress, kappa, mass weight, proximity dx - gap of the closest particle
 N_CBUF = 9
 
@@ -239,13 +236,8 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, fn_filtered, last_step, step, al
                 vn_after = max(vn, vn_min)
                 tau = interface_shear(model, iparams, pressure, kappa)
                 jt = 0.0
-                if area >= face:
-                    out[OUT_CAPPED] += 1.0
-                out[OUT_AREA] += area
                 if vt > 0.0:
                     jt = min(m * vt, tau * area * dt)
-                    if jt == m * vt:
-                        out[OUT_STICK] += 1.0
                     scale = 1.0 - jt / (m * vt)
                 else:
                     scale = 0.0

@@ -8,8 +8,8 @@ One step (model.md section 2):
 3. Contact: the rigid sphere on the nodes inside it, traction-limited interface shear (eq. 8);
    the reaction is the force on the sphere.
 4. Sphere motion: pressing, then sliding along x; its height floats under load control.
-5. G2P: velocities and velocity gradients back to the particles, stress update (eqs. 6.1-6.2,
-   7.1-7.3), advection, instability checks.
+5. G2P: velocities (APIC blended with the FLIP increment) and velocity gradients back to the
+   particles, stress update (eqs. 6.1-6.2, 7.1-7.3), advection, instability checks.
 
 The time step is dt = CFL dx / c with c = sqrt((K + 4G/3) / (ms rho)) the mass-scaled elastic
 wave speed.
@@ -98,7 +98,7 @@ class Work:
 
     grid_buf: np.ndarray
     grid_m: np.ndarray
-    grid_v: np.ndarray
+    grid_v: np.ndarray  # (nodes, 6): velocity, and velocity before the internal force (FLIP)
     flags: np.ndarray
     cbuf: np.ndarray
     fn_filtered: np.ndarray  # per-node filtered contact normal force, N
