@@ -78,6 +78,7 @@ class SteadyStop:
 
     def __init__(self, scene: Scene) -> None:
         a, _ = scene.expected_contact()
+        self.scene = scene
         self.window = scene.outputs.steady_window
         self.tolerance = scene.sliding.steady_tolerance
         self.every = scene.sliding.distance_m / self.CHECKS
@@ -90,9 +91,7 @@ class SteadyStop:
         if slid_m < self.next_check or not rec.rows:
             return False
         self.next_check += self.every
-        slid = np.array(rec.slid)
-        lo, hi = self.window
-        mask = (slid >= lo * slid_m) & (slid <= hi * slid_m)
+        mask = io.steady_window_mask(np.array(rec.slid), self.scene, slid_m)
         if mask.sum() < 3:
             return False
         fx = np.array([r["Fx"] for r in rec.rows])[mask].mean()
