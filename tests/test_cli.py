@@ -31,3 +31,26 @@ def test_python_m_and_help():
     bad = subprocess.run([sys.executable, "-m", "plough", *ARGS, "--interface", "sticky"],
                          capture_output=True, text=True)
     assert bad.returncode == 2 and "invalid choice" in bad.stderr
+
+
+def test_mpm_preset_reaches_the_solver(monkeypatch, tmp_path, capsys):
+    """``plough mpm --preset paper`` runs the paper's block; the solver is replaced by a recorder."""
+    from pathlib import Path
+
+    import plough.mpm.run as run
+
+    seen = []
+
+    def record(scene, **_kw):
+        seen.append(scene)
+        raise ValueError("recorded")
+
+    monkeypatch.setattr(run, "simulate", record)
+    scene = Path(__file__).resolve().parents[1] / "examples" / "coated_rigid_plastic.yaml"
+    out = tmp_path / "r.nc"
+    assert main(["mpm", str(scene), "-o", str(out), "--preset", "sized", "--quiet"]) == 2
+    assert main(["mpm", str(scene), "-o", str(out), "--preset", "paper", "--quiet"]) == 2
+    assert seen[0].domain.radius_m < 200e-6  # sized from the contact: 170 um at h = 10 um
+    assert (seen[1].domain.radius_m, seen[1].domain.length_m) == (200e-6, 1000e-6)
+    assert not out.exists()
+    assert "recorded" in capsys.readouterr().err

@@ -84,6 +84,9 @@ def _add_mpm(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--snapshots", default=None, help="directory for particle snapshots (.vtp)")
     p.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
+    p.add_argument("--preset", default=None, choices=["paper", "sized"],
+                   help="paper: the paper's 0.2 x 1 mm block, 0.6 mm slide, 0.1 m/s, mass scaling 1e6; "
+                   "sized: the block sized from the expected contact radius")
     p.set_defaults(func=_run_mpm)
 
 
@@ -93,7 +96,7 @@ def _run_mpm(args: argparse.Namespace) -> int:
     except ImportError as exc:  # pragma: no cover - until the solver lands
         raise ValueError(f"the MPM solver is not available in this build: {exc}") from None
     run_scene_file(args.scene, args.output, snapshots_dir=args.snapshots, threads=args.threads,
-                   progress=not args.quiet)
+                   progress=not args.quiet, preset=args.preset)
     return 0
 
 

@@ -305,3 +305,22 @@ def test_inertia_number_of_the_reference_scene():
     s = Scene.from_dict(example_dict())
     assert s.inertia_number == pytest.approx(1e6 * s.layers.substrate.density_kg_m3 * 0.01 / 900e6, rel=1e-12)
     assert 0.08 < s.inertia_number < 0.09
+
+
+def test_paper_preset_sets_the_papers_numerics_and_keeps_the_physics():
+    from plough.mpm.run import apply_preset
+
+    s = Scene.from_yaml(Path(__file__).resolve().parents[2] / "examples" / "coated_rigid_plastic.yaml")
+    s = s.with_(sliding=Sliding(distance_m=500e-6, speed_m_s=0.05),
+                discretisation=Discretisation(particle_size_m=5e-6, mass_scaling=1e4, cfl=0.2))
+    p = apply_preset(s, "paper")
+    assert (p.domain.radius_m, p.domain.length_m, p.domain.symmetric) == (200e-6, 1000e-6, True)
+    assert (p.sliding.distance_m, p.sliding.speed_m_s, p.discretisation.mass_scaling) == (600e-6, 0.1, 1e6)
+    assert p.outputs.steady_window == (0.5, 1.0)
+    # physics and the resolution are the scene's own
+    assert (p.layers, p.load_N, p.sphere, p.interface) == (s.layers, s.load_N, s.sphere, s.interface)
+    assert (p.discretisation.particle_size_m, p.discretisation.cfl) == (5e-6, 0.2)
+    assert apply_preset(s, None) is s
+    assert apply_preset(s, "sized").domain == s.with_sized_domain().domain
+    with pytest.raises(ValueError, match="preset = 'fast' is unknown"):
+        apply_preset(s, "fast")

@@ -171,10 +171,27 @@ def _update_bar(bar, state: solver.State, rec: _Recorder) -> None:
     bar.update(slid_um - bar.n)
 
 
+#: Named numerical presets a scene file can be run with (``plough mpm --preset``).
+PRESETS = ("paper", "sized")
+
+
+def apply_preset(scene: Scene, preset: str | None) -> Scene:
+    """``paper``: the paper's block, slide, speed and mass scaling (``Scene.with_paper_settings``);
+    ``sized``: the block sized from the expected contact (``Scene.with_sized_domain``)."""
+    if preset is None:
+        return scene
+    if preset == "paper":
+        return scene.with_paper_settings()
+    if preset == "sized":
+        return scene.with_sized_domain()
+    raise ValueError(f"preset = {preset!r} is unknown; allowed: {', '.join(PRESETS)}")
+
+
 def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir: str | Path | None = None,
-                   threads: int | None = None, progress: bool = True) -> Path:
-    """Read a scene YAML, simulate, write the netCDF atomically (nothing is written on failure)."""
-    scene = Scene.from_yaml(Path(scene_path))
+                   threads: int | None = None, progress: bool = True, preset: str | None = None) -> Path:
+    """Read a scene YAML, apply the optional preset, simulate, write the netCDF atomically
+    (nothing is written on failure)."""
+    scene = apply_preset(Scene.from_yaml(Path(scene_path)), preset)
     ds = simulate(scene, progress=progress, snapshots_dir=snapshots_dir, threads=threads)
     return io.write_result(ds, output)
 

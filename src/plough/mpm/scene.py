@@ -151,6 +151,10 @@ class Domain:
             raise ValueError(f"domain.symmetric = {self.symmetric!r} must be true or false")
 
 
+#: The paper's block: a half cylinder of radius 0.2 mm and length 1 mm, mirror plane at y = 0.
+PAPER_DOMAIN = Domain(radius_m=200e-6, length_m=1000e-6, symmetric=True)
+
+
 @dataclass(frozen=True)
 class Sliding:
     """Path of the sphere: press to the load (or to a depth), then slide ``distance_m`` along x.
@@ -440,6 +444,17 @@ class Scene:
                            self.discretisation.particle_size_m, self.domain.symmetric,
                            radius_contact_radii, end_margin_contact_radii)
         return replace(self, domain=dom)
+
+    def with_paper_settings(self) -> Scene:
+        """The paper's numerical setup as a named preset: the fixed 0.2 mm x 1 mm half cylinder
+        (mirror plane on), a 0.6 mm slide at 0.1 m/s, mass scaling 1e6, uniform particles, steady
+        window the last half of the slide. Physics (layers, load, sphere, interface) and the
+        particle size, CFL number and transfer are kept. ``benchmarks/work_precision.py`` runs it
+        beside the defaults."""
+        return replace(self, domain=PAPER_DOMAIN,
+                       sliding=replace(self.sliding, distance_m=600e-6, speed_m_s=0.1),
+                       discretisation=replace(self.discretisation, mass_scaling=1e6),
+                       outputs=replace(self.outputs, steady_window=(0.5, 1.0)))
 
     def with_(self, **changes: Any) -> Scene:
         """A copy with some top-level parts replaced (validated again)."""
