@@ -4,6 +4,7 @@ The runs import the installed plough (whose numba cache is warm); the copied ``s
 package sources that every rule takes as an input, as in a checkout.
 """
 
+import copy
 import json
 import math
 import shutil
@@ -107,3 +108,47 @@ def test_full_matrix_dry_run_schedules_every_run_once(tmp_path):
     assert counts["figure"] == len(matrix.MPM_FIGURES) + 3  # and Figs. 3, 4, 22
     assert counts["numba_warmup"] == 1
     assert counts["total"] == sum(n for name, n in counts.items() if name != "total")
+
+
+@pytest.mark.slow
+def test_smoke_skip_finest_writes_markers_where_the_coarser_sizes_agree(tmp_path):
+    """mpm.skip_finest_tolerance end to end on Fig. 15: the coarser runs first, then a tolerance
+    between the points' two-size uncertainties, so that some finest runs are skipped and some run;
+    each decision follows plough.study.skipping from the run files, and the dataset says which."""
+    from plough.study import skipping
+
+    work = _project_copy(tmp_path)
+    sizes = matrix.particle_sizes_um(SMOKE)
+    finest_ids = [r for r in matrix.figure_runs(SMOKE, "fig15") if r.endswith(f"_h{matrix.fmt(sizes[-1])}")]
+    stems = [r.rsplit("_h", 1)[0] for r in finest_ids]
+    coarse = [f"results/runs/{s}_h{matrix.fmt(h)}.nc" for s in stems for h in sizes[:2]]
+    out = _snakemake(work, "--configfile=config/smoke.yaml", *coarse)
+    assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+
+    def worst(stem: str) -> float:
+        runs = [xr.load_dataset(work / f"results/runs/{stem}_h{matrix.fmt(h)}.nc") for h in sizes[:2]]
+        ex = skipping.two_size_extrapolation(*runs, sizes[0], sizes[1])
+        return max(e["relative_uncertainty"] for e in ex.values())
+
+    cfg = copy.deepcopy(SMOKE)
+    cfg["mpm"]["skip_finest_tolerance"] = 0.5
+    skippable = matrix.skippable_runs(cfg)
+    spread = sorted(worst(s) for r, s in zip(finest_ids, stems, strict=True) if r in skippable)
+    assert len(spread) >= 2 and spread[0] < spread[-1]
+    tol = min(0.5 * (spread[0] + spread[-1]), 0.99)
+    cfg["mpm"]["skip_finest_tolerance"] = tol
+    (work / "config" / "smoke.yaml").write_text(yaml.safe_dump(cfg))
+    out = _snakemake(work, "--configfile=config/smoke.yaml", "results/datasets/fig15.nc")
+    assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+    assert "mpm_run" in out.stdout + out.stderr  # only the finest runs were left to do
+
+    ds = xr.load_dataset(work / "results/datasets/fig15.nc")
+    n_skipped = 0
+    for rid, stem in zip(finest_ids, stems, strict=True):
+        run = xr.load_dataset(work / "results/runs" / f"{rid}.nc")
+        expect = rid in skippable and worst(stem) <= tol  # a picture's run always runs
+        assert skipping.is_skipped(run) == expect, rid
+        n_skipped += expect
+    assert 0 < n_skipped < len(finest_ids)
+    assert int(ds["skipped_finest"].sum()) == n_skipped
+    assert np.isfinite(ds["mu_h0"].values).all() and np.isfinite(ds["dp_h0"].values).all()

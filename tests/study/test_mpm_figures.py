@@ -376,3 +376,49 @@ def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):
     a = build_dataset(SMOKE, "fig16", run_files)
     b = build_dataset(copy.deepcopy(SMOKE), "fig16", reordered)
     xr.testing.assert_identical(a, b)
+
+
+def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_files, tmp_path):
+    """A skip marker at the finest size: that point's h -> 0 value is the two-size Richardson
+    extrapolation (order 1, safety factor 3), flagged; its finest per-size values are missing (NaN,
+    declared), every other point is untouched; the dataset passes the atomic writer and draws."""
+    from plough.study import skipping
+
+    real = MPM["real_materials"]
+    loads = [float(x) for x in real["loads_N"]]
+    r1 = float(real["ball_radii_um"][0])
+    point = matrix.real_point(real, "zinc_block", loads[0], r1)
+    finest = matrix.run_id(point, min(SIZES))
+    paths = dict(run_files)
+    paths[finest] = tmp_path / f"{finest}.nc"
+    write_netcdf_atomic(skipping.skip_marker({"name": finest}, {}, 0.1, []), paths[finest])
+
+    ds = build_dataset(SMOKE, "fig15", paths)
+    sel = {"material": "zinc_block", "load_N": loads[0]}
+    sig = signature(loads[0], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer")
+    h3, h2 = sorted(SIZES, reverse=True)[:2]  # 20, 14
+    for o in matrix.OUTPUTS:
+        f3, f2 = value(o, sig, h3), value(o, sig, h2)
+        gain = 1.0 / (h3 / h2 - 1.0)
+        assert float(ds[f"{o}_h0"].sel(sel)) == pytest.approx(f2 + (f2 - f3) * gain, rel=1e-12), o
+        assert float(ds[f"{o}_h0_uncertainty"].sel(sel)) == pytest.approx(3.0 * abs(f2 - f3) * gain, rel=1e-12)
+        assert int(ds[f"{o}_h0_method"].sel(sel)) == Method.TWO_SIZES_ASSUMED_ORDER
+        assert int(ds[f"{o}_h0_flagged"].sel(sel)) == 1
+        assert np.isnan(float(ds[o].sel(sel).sel(h=min(SIZES))))
+        _check_extrapolation(ds, o, {"material": "zinc_block", "load_N": loads[1]},
+                             signature(loads[1], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer"))
+    assert int(ds["skipped_finest"].sum()) == 1 and int(ds["skipped_finest"].sel(sel)) == 1
+    _draws("fig15", _written(ds, tmp_path), tmp_path)
+
+
+def test_a_skip_marker_at_a_coarser_size_is_refused(run_files, tmp_path):
+    from plough.study import skipping
+
+    real = MPM["real_materials"]
+    point = matrix.real_point(real, "steel", float(real["loads_N"][0]), float(real["ball_radii_um"][0]))
+    rid = matrix.run_id(point, max(SIZES))
+    paths = dict(run_files)
+    paths[rid] = tmp_path / f"{rid}.nc"
+    write_netcdf_atomic(skipping.skip_marker({"name": rid}, {}, 0.1, []), paths[rid])
+    with pytest.raises(ValueError, match="is not the finest size"):
+        build_dataset(SMOKE, "fig15", paths)

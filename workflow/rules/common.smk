@@ -18,6 +18,9 @@ MPM_RUNS = matrix.all_runs(config)
 MPM_THREADS = int(config["mpm"]["threads"])
 # particles and steps of every run, for the memory and wall-time requests of cluster jobs
 MPM_COST = {rid: cost.estimate(Scene.from_dict(scene)) for rid, scene in MPM_RUNS.items()}
+# finest-size runs that may be skipped (mpm.skip_finest_tolerance): run id -> its two coarser runs
+SKIPPABLE = matrix.skippable_runs(config)
+SKIP_TOLERANCE = config["mpm"].get("skip_finest_tolerance")
 
 
 def runs_of(figure):

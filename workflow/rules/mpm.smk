@@ -19,14 +19,19 @@ rule numba_warmup:
 
 # The whole scene (materials expanded, SI) is the job's params: changing one material parameter
 # reruns exactly the runs that use it. The package source is an input for the same reason.
+# A skippable finest-size run first reads its point's two coarser runs: if their extrapolation is
+# within mpm.skip_finest_tolerance its result file is a skip marker (plough.study.skipping).
 rule mpm_run:
     input:
         PACKAGE_SOURCES,
         warm="results/.numba_warm",
+        coarser=lambda wc: [f"results/runs/{r}.nc" for r in SKIPPABLE.get(wc.run, ())],
     output:
         "results/runs/{run}.nc",
     params:
         scene=lambda wc: MPM_RUNS[wc.run],
+        skip_tolerance=lambda wc: SKIP_TOLERANCE if wc.run in SKIPPABLE else None,
+        sizes_um=lambda wc: list(matrix.particle_sizes_um(config)),
     wildcard_constraints:
         run="|".join(re.escape(r) for r in MPM_RUNS) if MPM_RUNS else "NO_RUNS",
     threads: MPM_THREADS

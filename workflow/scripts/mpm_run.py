@@ -1,20 +1,48 @@
-"""Snakemake script: one MPM run, its progress bar in the job's log, the result written atomically."""
+"""Snakemake script: one MPM run, its progress bar in the job's log, the result written atomically.
+
+A finest-size run with ``params.skip_tolerance`` set first extrapolates its point's two coarser
+runs; within the tolerance it writes a skip marker instead of running (plough.study.skipping).
+"""
 
 import sys
 
+import xarray as xr
+
+from plough.io import write_netcdf_atomic
 from plough.mpm.io import write_result
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
+from plough.study import skipping
 
 smk = snakemake  # noqa: F821 - injected by Snakemake
+
+
+def skipped(log) -> bool:
+    """Write the skip marker and say so when the two coarser runs extrapolate within the tolerance."""
+    if smk.params.skip_tolerance is None:
+        return False
+    coarse, mid = (xr.load_dataset(p) for p in smk.input.coarser)
+    h_coarse, h_mid = smk.params.sizes_um[-3], smk.params.sizes_um[-2]
+    ex = skipping.two_size_extrapolation(coarse, mid, h_coarse, h_mid)
+    print(f"two-size extrapolation of h = {h_coarse:g}, {h_mid:g} um: {ex}", file=log)
+    if not skipping.should_skip(ex, smk.params.skip_tolerance):
+        return False
+    marker = skipping.skip_marker(smk.params.scene, ex, smk.params.skip_tolerance, list(smk.input.coarser))
+    write_netcdf_atomic(marker, smk.output[0])
+    print(f"skipped (within skip_finest_tolerance = {smk.params.skip_tolerance:g}): wrote the marker "
+          f"{smk.output[0]}", file=log)
+    return True
+
+
 with open(smk.log[0], "w", buffering=1) as log:
     sys.stderr = log  # the progress bar (sliding distance, ETA, Fx/Fz) goes to logs/runs/<run>.log
     scene = Scene.from_dict(smk.params.scene)
-    try:
-        ds = simulate(scene, progress=True, threads=smk.threads)
-    except Exception as exc:  # the solver's message in the log, then the job fails
-        print(f"\nrun {scene.name} failed: {type(exc).__name__}: {exc}", file=log)
-        raise
-    write_result(ds, smk.output[0])
-    print(f"\nwrote {smk.output[0]}: mu = {float(ds.mu):.4g}, dp = {float(ds.dp):.4g} m, "
-          f"{ds.attrs['cost_wall_time_s']:.1f} s wall", file=log)
+    if not skipped(log):
+        try:
+            ds = simulate(scene, progress=True, threads=smk.threads)
+        except Exception as exc:  # the solver's message in the log, then the job fails
+            print(f"\nrun {scene.name} failed: {type(exc).__name__}: {exc}", file=log)
+            raise
+        write_result(ds, smk.output[0])
+        print(f"\nwrote {smk.output[0]}: mu = {float(ds.mu):.4g}, dp = {float(ds.dp):.4g} m, "
+              f"{ds.attrs['cost_wall_time_s']:.1f} s wall", file=log)

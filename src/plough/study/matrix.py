@@ -287,6 +287,24 @@ def all_runs(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> 
     return dict(sorted(runs.items()))
 
 
+def skippable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
+    """finest-size run id -> (coarsest, middle) run ids of the same point, for the runs that may be
+    skipped (``plough.study.skipping``): empty unless ``mpm.skip_finest_tolerance`` is set and there
+    are at least three sizes; never a run a picture (single-run figure) needs."""
+    if config["mpm"].get("skip_finest_tolerance") is None:
+        return {}
+    sizes = particle_sizes_um(config)
+    if len(sizes) < 3:
+        return {}
+    pictures = {rid for fig in SINGLE_RUN_FIGURES for rid in figure_runs(config, fig)}
+    out = {}
+    for p in all_points(config, SWEEP_FIGURES).values():
+        finest = run_id(p, sizes[-1])
+        if finest not in pictures:
+            out[finest] = (run_id(p, sizes[-3]), run_id(p, sizes[-2]))
+    return dict(sorted(out.items()))
+
+
 def analytical_values(point: Point, correction: str = "none") -> dict[str, float]:
     """The analytical model (eqs. 1-5) at a point: mu, mu_pl, mu_sh, dp."""
     from plough.analytical import ploughing

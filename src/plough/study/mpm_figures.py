@@ -25,6 +25,7 @@ from plough.io import provenance_attrs
 from plough.mpm.io import STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import extrapolate_dataarray
+from plough.study.skipping import is_skipped
 
 TITLES = {
     "fig11": "Fig. 11 - ploughing depth dp, MPM vs analytical, rigid-plastic coating",
@@ -74,10 +75,17 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     per_size = {o: np.full(shape, np.nan) for o in (*matrix.OUTPUTS, "Fz_mean", "max_particle_penetration")}
     wall = np.full(shape, np.nan)
     analytical = {o: np.full(shape[:2], np.nan) for o in matrix.ANALYTICAL_OUTPUTS}
+    skipped = np.zeros(shape[:2], dtype=bool)
     for i, series in enumerate(panel.series):
         for j, point in enumerate(series.points):
             for k, h in enumerate(sizes_um):
-                ds = runs[matrix.run_id(point, h)]
+                rid = matrix.run_id(point, h)
+                ds = runs[rid]
+                if is_skipped(ds):
+                    if h != min(sizes_um):
+                        raise ValueError(f"run {rid!r} is a skip marker but h = {h:g} um is not the finest size")
+                    skipped[i, j] = True
+                    continue
                 for o in per_size:
                     per_size[o][i, j, k] = float(ds[o])
                 wall[i, j, k] = float(ds.attrs["cost_wall_time_s"])
@@ -88,14 +96,18 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     for o, values in per_size.items():
         units, long_name = STEADY_META[o]
         da = xr.DataArray(values, dims=dims3, coords=coords, name=o,
-                          attrs={"units": units, "long_name": f"{long_name} (MPM, per particle size)"})
+                          attrs={"units": units, "long_name": f"{long_name} (MPM, per particle size)",
+                                 **({"allow_missing": 1} if skipped.any() else {})})
         out[o + suffix] = da
         if o not in matrix.OUTPUTS:
             continue
         ex = extrapolate_dataarray(da, "h")
+        # points whose finest run was skipped: the two coarser sizes' extrapolation (flagged)
+        ex_coarse = extrapolate_dataarray(da.sel(h=[x for x in sizes_um if x != min(sizes_um)]), "h") \
+            if skipped.any() else ex
         for field in ("value", "uncertainty", "order", "method", "flagged"):
             name = f"{o}_h0{suffix}" if field == "value" else f"{o}_h0_{field}{suffix}"
-            var = ex[field]
+            var = ex[field].copy(data=np.where(skipped, ex_coarse[field].values, ex[field].values))
             if var.dtype == bool:
                 var = var.astype(np.int8)
             if field == "order":
@@ -106,7 +118,11 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
         out[f"{o}_analytical{suffix}"] = ((panel.series_dim, panel.axis), values,
                                           {"units": units, "long_name": f"{long_name} (analytical model, eqs. 1-5)",
                                            "allow_missing": 1})
-    out[f"wall_time_s{suffix}"] = (dims3, wall, {"units": "s", "long_name": "wall time of the run"})
+    out[f"wall_time_s{suffix}"] = (dims3, wall, {"units": "s", "long_name": "wall time of the run",
+                                                 **({"allow_missing": 1} if skipped.any() else {})})
+    out[f"skipped_finest{suffix}"] = ((panel.series_dim, panel.axis), skipped.astype(np.int8),
+                                      {"units": "1", "long_name": "finest size skipped (mpm.skip_finest_tolerance): "
+                                       "extrapolated from the two coarser sizes"})
     return out
 
 

@@ -1,0 +1,65 @@
+"""Skipping the finest particle size where the two coarser sizes already extrapolate well enough.
+
+The finest size costs about 8 x 2 = 16 times the next one (eight times the particles, twice the
+steps), so it dominates the full reproduction. With ``mpm.skip_finest_tolerance`` set, the run of
+a sweep point at the finest size first reads the point's two next-coarser runs and extrapolates
+them to h -> 0 (:func:`plough.study.extrapolation.extrapolate` with two sizes: Richardson with the
+assumed order 1 and Roache's safety factor 3). If that extrapolation's uncertainty is within the
+tolerance of its value for every steady-state output in :data:`CHECKED` the finest run is not
+made: its result file is a *skip marker* (no result variables; attributes say why, with the two
+extrapolations), and the figure dataset extrapolates that point from the two coarser sizes, flagged
+``TWO_SIZES_ASSUMED_ORDER``. Pictures (the single-run figures) always use a real finest run.
+
+Default off (``null``): the faithful reproduction runs every size.
+"""
+
+from __future__ import annotations
+
+import json
+from typing import Any
+
+import numpy as np
+import xarray as xr
+
+from plough.io import provenance_attrs
+from plough.study.extrapolation import extrapolate
+
+#: Outputs whose two-size extrapolation must be within the tolerance to skip the finest run.
+CHECKED = ("mu", "dp")
+SKIPPED_ATTR = "skipped_finest_size"
+
+
+def two_size_extrapolation(coarse: xr.Dataset, mid: xr.Dataset, h_coarse_um: float, h_mid_um: float,
+                           outputs: tuple[str, ...] = CHECKED) -> dict[str, dict[str, float]]:
+    """output -> {value, uncertainty, relative_uncertainty} of the two-size extrapolation."""
+    out = {}
+    for o in outputs:
+        ex = extrapolate([h_coarse_um, h_mid_um], [float(coarse[o]), float(mid[o])])
+        value, unc = float(ex.value), float(ex.uncertainty)
+        rel = unc / abs(value) if value != 0 else (0.0 if unc == 0 else np.inf)
+        out[o] = {"value": value, "uncertainty": unc, "relative_uncertainty": rel}
+    return out
+
+
+def should_skip(extrapolations: dict[str, dict[str, float]], tolerance: float) -> bool:
+    """True when every checked output's relative uncertainty is within ``tolerance``."""
+    if not (np.isfinite(tolerance) and 0 < tolerance < 1):
+        raise ValueError(f"mpm.skip_finest_tolerance = {tolerance!r} is outside the allowed range (0, 1)")
+    return all(np.isfinite(e["relative_uncertainty"]) and e["relative_uncertainty"] <= tolerance
+               for e in extrapolations.values())
+
+
+def skip_marker(scene: dict[str, Any], extrapolations: dict[str, dict[str, float]], tolerance: float,
+                coarse_runs: list[str]) -> xr.Dataset:
+    """The result file of a skipped run: no result variables, the reason and provenance as attributes."""
+    return xr.Dataset(attrs={
+        SKIPPED_ATTR: 1,
+        "skip_reason": (f"the two-size extrapolation of {', '.join(coarse_runs)} is within "
+                        f"skip_finest_tolerance = {tolerance:g} for {', '.join(extrapolations)}"),
+        "skip_extrapolations": json.dumps(extrapolations),
+        **provenance_attrs(scene, key="scene"),
+    })
+
+
+def is_skipped(ds: xr.Dataset) -> bool:
+    return bool(ds.attrs.get(SKIPPED_ATTR, 0))

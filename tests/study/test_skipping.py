@@ -1,0 +1,72 @@
+"""plough.study.skipping: the decision to skip the finest size, the marker, the skippable runs."""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from plough.study import matrix, skipping
+
+ROOT = Path(__file__).resolve().parents[2]
+SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+
+
+def _run(mu: float, dp: float) -> xr.Dataset:
+    return xr.Dataset({"mu": ((), mu), "dp": ((), dp)})
+
+
+def test_two_size_extrapolation_is_richardson_order_one_with_safety_factor_three():
+    ex = skipping.two_size_extrapolation(_run(0.40, 5e-6), _run(0.44, 6e-6), 20.0, 10.0)
+    assert ex["mu"]["value"] == pytest.approx(0.48, rel=1e-12)  # r = 2, p = 1: f1 + (f1 - f2)
+    assert ex["mu"]["uncertainty"] == pytest.approx(3 * 0.04, rel=1e-12)
+    assert ex["mu"]["relative_uncertainty"] == pytest.approx(0.12 / 0.48, rel=1e-12)
+    assert ex["dp"]["value"] == pytest.approx(7e-6, rel=1e-12)
+    assert skipping.should_skip(ex, 0.45) and not skipping.should_skip(ex, 0.40)  # dp: 3e-6 / 7e-6 = 0.43
+    converged = skipping.two_size_extrapolation(_run(0.4, 5e-6), _run(0.4, 5e-6), 20.0, 10.0)
+    assert skipping.should_skip(converged, 1e-6)
+
+
+@pytest.mark.parametrize("tol", [0.0, 1.0, -0.1, float("nan")])
+def test_tolerance_outside_its_range_is_refused(tol):
+    ex = skipping.two_size_extrapolation(_run(0.4, 5e-6), _run(0.4, 5e-6), 20.0, 10.0)
+    with pytest.raises(ValueError, match="skip_finest_tolerance"):
+        skipping.should_skip(ex, tol)
+
+
+def test_non_finite_uncertainty_never_skips():
+    ex = {"mu": {"value": 0.0, "uncertainty": 1.0, "relative_uncertainty": np.inf}}
+    assert not skipping.should_skip(ex, 0.5)
+
+
+def test_marker_carries_provenance_and_no_results():
+    ex = skipping.two_size_extrapolation(_run(0.40, 5e-6), _run(0.44, 6e-6), 20.0, 10.0)
+    m = skipping.skip_marker({"name": "p_h5"}, ex, 0.5, ["a.nc", "b.nc"])
+    assert skipping.is_skipped(m) and not skipping.is_skipped(_run(0.4, 1e-6))
+    assert not m.data_vars
+    assert json.loads(m.attrs["scene"]) == {"name": "p_h5"}
+    assert json.loads(m.attrs["skip_extrapolations"])["mu"]["value"] == pytest.approx(0.48)
+    assert m.attrs["plough_version"] and "a.nc" in m.attrs["skip_reason"]
+
+
+def test_skippable_runs_are_finest_sweep_runs_never_pictures():
+    assert matrix.skippable_runs(SMOKE) == {}  # off by default
+    cfg = copy.deepcopy(SMOKE)
+    cfg["mpm"]["skip_finest_tolerance"] = 0.05
+    skippable = matrix.skippable_runs(cfg)
+    sizes = matrix.particle_sizes_um(cfg)
+    pictures = {rid for fig in matrix.SINGLE_RUN_FIGURES for rid in matrix.figure_runs(cfg, fig)}
+    sweep_finest = {rid for fig in matrix.SWEEP_FIGURES for rid in matrix.figure_runs(cfg, fig)
+                    if rid.endswith(f"_h{matrix.fmt(sizes[-1])}")}
+    assert skippable and set(skippable) == sweep_finest - pictures
+    assert pictures & sweep_finest  # the smoke matrix has a picture that is also a sweep point
+    for finest, (coarse, mid) in skippable.items():
+        stem = finest.rsplit("_h", 1)[0]
+        assert (coarse, mid) == (f"{stem}_h{matrix.fmt(sizes[0])}", f"{stem}_h{matrix.fmt(sizes[1])}")
+    cfg["mpm"]["particle_sizes_um"] = [20, 10]
+    assert matrix.skippable_runs(cfg) == {}  # two sizes: nothing left to extrapolate from
