@@ -1,14 +1,16 @@
 """Inertia check of issue 3 at h = 5 um: the reference scene (sized block) with mass scaling / 2
-and with sliding speed / 2 against the defaults.
+and with sliding speed / 2, / 4, / 8 against the defaults.
 
-    python benchmarks/inertia_h5.py
+    python benchmarks/inertia_h5.py [--only NAME ...]
 
-Writes benchmarks/results/inertia_h5.json. See benchmarks/timestep_check.py for why speed / 2
-also changes the steps per sliding distance (and what that does).
+Writes benchmarks/results/inertia_h5.json, keeping the cases already there (a case is run only when
+it is missing or named in --only). Speed / k is the inertia number ms rho v^2 / H / k^2 at k times
+the steps (mass scaling / k^2 gives the same numbers, benchmarks/timestep_check.py).
 """
 
 from __future__ import annotations
 
+import argparse
 import json
 from dataclasses import replace
 from pathlib import Path
@@ -22,19 +24,27 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--only", nargs="*", default=None, help="(re)run only these cases")
+    args = parser.parse_args()
     numba.set_num_threads(2)
     base = Scene.from_yaml(ROOT / "examples" / "uncoated_rigid_plastic.yaml")
     base = replace(base, discretisation=replace(base.discretisation, particle_size_m=5e-6)).with_sized_domain()
     cases = {"baseline": base,
-             "mass_scaling/2": replace(base, discretisation=replace(base.discretisation, mass_scaling=5e5)),
-             "speed/2": replace(base, sliding=replace(base.sliding, speed_m_s=0.05))}
-    rows = {}
+             "mass_scaling/2": replace(base, discretisation=replace(base.discretisation, mass_scaling=5e5))}
+    for k in (2, 4, 8):
+        cases[f"speed/{k}"] = replace(base, sliding=replace(base.sliding, speed_m_s=0.1 / k))
+    out = ROOT / "benchmarks" / "results" / "inertia_h5.json"
+    rows = json.loads(out.read_text()) if out.exists() else {}
     for name, s in cases.items():
+        if (args.only is None and name in rows) or (args.only is not None and name not in args.only):
+            continue
         ds = simulate(s, progress=False)
         rows[name] = {k: float(ds[k]) for k in ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")}
-        rows[name].update(wall_s=ds.attrs["cost_wall_time_s"], particles=int(ds.attrs["cost_particles"]))
+        rows[name].update(wall_s=ds.attrs["cost_wall_time_s"], particles=int(ds.attrs["cost_particles"]),
+                          steps=int(ds.attrs["cost_steps"]), inertia_number=s.inertia_number)
         print(name, json.dumps(rows[name]), flush=True)
-    (ROOT / "benchmarks" / "results" / "inertia_h5.json").write_text(json.dumps(rows, indent=2) + "\n")
+        out.write_text(json.dumps(rows, indent=2) + "\n")
 
 
 if __name__ == "__main__":
