@@ -39,9 +39,16 @@ class Grid:
 
 
 def make_grid(length_m: float, radius_m: float, symmetric: bool, dx: float, headroom_m: float) -> Grid:
-    """A grid over x in [0, L], y in [0, R] (or [-R, R]), z in [-R, headroom], padded."""
+    """A grid over x in [0, L], y in [0, R] (or [-R, R]), z in [-R, headroom], padded.
+
+    The top face z = 0 and the plane y = 0 are node planes whatever R is: where the free surface
+    falls between nodes changes how the contact nodes see it (the coated reference scene at
+    h = 10 um: mu_pl 0.169 with the surface at mid-cell, R = 170 um, against 0.122 on a node
+    plane, R = 200 um), so a block radius that is not a whole number of cells must not shift it.
+    """
     pad = PAD_CELLS * dx
-    lo = np.array([-pad, -pad if symmetric else -radius_m - pad, -radius_m - pad])
+    below = dx * np.ceil((radius_m + pad) / dx - 1e-9)  # a whole number of cells below z = 0 (and y = 0)
+    lo = np.array([-pad, -pad if symmetric else -below, -below])
     hi = np.array([length_m + pad, radius_m + pad, headroom_m + pad])
     shape = tuple(int(np.ceil((hi[d] - lo[d]) / dx)) + 1 for d in range(3))
     return Grid(origin=lo, dx=dx, shape=shape)
