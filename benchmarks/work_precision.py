@@ -87,7 +87,8 @@ def run_one(scene: Scene, threads: int) -> dict[str, float]:
     t0 = time.perf_counter()
     ds = simulate(scene, progress=False, threads=threads)
     row = {k: float(ds[k]) for k in ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")}
-    row.update(wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
+    row.update(git_commit=str(ds.attrs.get("git_commit", "unknown")),
+               wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
                steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]),
                h_um=scene.discretisation.particle_size_m * 1e6, inertia_number=scene.inertia_number,
                load_N=scene.load_N)
@@ -224,6 +225,14 @@ def main() -> None:
     if not ref:
         print("fewer than two ladder sizes done: no reference yet")
         return
+    commits = sorted({r.get("git_commit", "unknown") for r in runs.values()})
+    if len(commits) > 1:
+        print(f"warning: the runs come from {len(commits)} code versions {commits}; rerun the stale ones "
+              "(delete them from the results file) if the solver changed between them")
+    for q, r in ref.items():
+        if r["method"] != "RICHARDSON":
+            print(f"warning: the reference {q} is a {r['method']} extrapolation: its uncertainty is wide and "
+                  "errors below it are not resolved")
     err = errors(runs, ref)
     data["reference"] = ref
     data["pareto"] = {q: pareto(runs, err, q) for q in QUANTITIES}

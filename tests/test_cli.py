@@ -1,6 +1,8 @@
 import subprocess
 import sys
 
+import pytest
+
 from plough.cli import main
 
 ARGS = ["analytical", "--radius-mm", "0.2", "--load-N", "3", "--thickness-um", "25",
@@ -46,11 +48,15 @@ def test_mpm_preset_reaches_the_solver(monkeypatch, tmp_path, capsys):
         raise ValueError("recorded")
 
     monkeypatch.setattr(run, "simulate", record)
-    scene = Path(__file__).resolve().parents[1] / "examples" / "coated_rigid_plastic.yaml"
+    text = (Path(__file__).resolve().parents[1] / "examples" / "coated_rigid_plastic.yaml").read_text()
+    assert "domain: {radius_um: 200, length_um: 1000," in text
+    scene = tmp_path / "scene.yaml"  # a block that is neither the paper's nor sized
+    scene.write_text(text.replace("domain: {radius_um: 200, length_um: 1000,", "domain: {radius_um: 300, "
+                                  "length_um: 1200,"))
     out = tmp_path / "r.nc"
     assert main(["mpm", str(scene), "-o", str(out), "--preset", "sized", "--quiet"]) == 2
     assert main(["mpm", str(scene), "-o", str(out), "--preset", "paper", "--quiet"]) == 2
-    assert seen[0].domain.radius_m < 200e-6  # sized from the contact: 170 um at h = 10 um
+    assert seen[0].domain.radius_m == pytest.approx(170e-6)  # sized from the contact at h = 10 um
     assert (seen[1].domain.radius_m, seen[1].domain.length_m) == (200e-6, 1000e-6)
     assert not out.exists()
     assert "recorded" in capsys.readouterr().err

@@ -311,11 +311,12 @@ def test_paper_preset_sets_the_papers_numerics_and_keeps_the_physics():
     from plough.mpm.run import apply_preset
 
     s = Scene.from_yaml(Path(__file__).resolve().parents[2] / "examples" / "coated_rigid_plastic.yaml")
-    s = s.with_(sliding=Sliding(distance_m=500e-6, speed_m_s=0.05),
+    s = s.with_(sliding=Sliding(distance_m=500e-6, speed_m_s=0.05, stop_when_steady=True),
                 discretisation=Discretisation(particle_size_m=5e-6, mass_scaling=1e4, cfl=0.2))
     p = apply_preset(s, "paper")
     assert (p.domain.radius_m, p.domain.length_m, p.domain.symmetric) == (200e-6, 1000e-6, True)
     assert (p.sliding.distance_m, p.sliding.speed_m_s, p.discretisation.mass_scaling) == (600e-6, 0.1, 1e6)
+    assert not p.sliding.stop_when_steady  # the paper slides the whole 0.6 mm
     assert p.outputs.steady_window == (0.5, 1.0)
     # physics and the resolution are the scene's own
     assert (p.layers, p.load_N, p.sphere, p.interface) == (s.layers, s.load_N, s.sphere, s.interface)

@@ -393,7 +393,12 @@ def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_fil
     paths[finest] = tmp_path / f"{finest}.nc"
     write_netcdf_atomic(skipping.skip_marker({"name": finest}, {}, 0.1, []), paths[finest])
 
-    ds = build_dataset(SMOKE, "fig15", paths)
+    with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
+        build_dataset(SMOKE, "fig15", paths)  # skip_finest_tolerance null: a marker is a stale file
+    config = copy.deepcopy(SMOKE)
+    config["mpm"]["skip_finest_tolerance"] = 0.05
+    assert finest in matrix.skippable_runs(config)
+    ds = build_dataset(config, "fig15", paths)
     sel = {"material": "zinc_block", "load_N": loads[0]}
     sig = signature(loads[0], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer")
     h3, h2 = sorted(SIZES, reverse=True)[:2]  # 20, 14
@@ -420,5 +425,7 @@ def test_a_skip_marker_at_a_coarser_size_is_refused(run_files, tmp_path):
     paths = dict(run_files)
     paths[rid] = tmp_path / f"{rid}.nc"
     write_netcdf_atomic(skipping.skip_marker({"name": rid}, {}, 0.1, []), paths[rid])
-    with pytest.raises(ValueError, match="is not the finest size"):
-        build_dataset(SMOKE, "fig15", paths)
+    config = copy.deepcopy(SMOKE)
+    config["mpm"]["skip_finest_tolerance"] = 0.05
+    with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
+        build_dataset(config, "fig15", paths)

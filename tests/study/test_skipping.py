@@ -68,5 +68,9 @@ def test_skippable_runs_are_finest_sweep_runs_never_pictures():
     for finest, (coarse, mid) in skippable.items():
         stem = finest.rsplit("_h", 1)[0]
         assert (coarse, mid) == (f"{stem}_h{matrix.fmt(sizes[0])}", f"{stem}_h{matrix.fmt(sizes[1])}")
+    cfg["mpm"]["particle_sizes_um"] = [40, 20, 14, 10]  # four sizes: the two next to the finest
+    for finest, (coarse, mid) in matrix.skippable_runs(cfg).items():
+        stem = finest.rsplit("_h", 1)[0]
+        assert (finest, coarse, mid) == (f"{stem}_h10", f"{stem}_h20", f"{stem}_h14")
     cfg["mpm"]["particle_sizes_um"] = [20, 10]
     assert matrix.skippable_runs(cfg) == {}  # two sizes: nothing left to extrapolate from

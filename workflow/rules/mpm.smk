@@ -20,7 +20,9 @@ rule numba_warmup:
 # The whole scene (materials expanded, SI) is the job's params: changing one material parameter
 # reruns exactly the runs that use it. The package source is an input for the same reason.
 # A skippable finest-size run first reads its point's two coarser runs: if their extrapolation is
-# within mpm.skip_finest_tolerance its result file is a skip marker (plough.study.skipping).
+# within mpm.skip_finest_tolerance its result file is a skip marker (plough.study.skipping). The
+# skip params are None for every other run, so they never trigger reruns of those; changing the
+# tolerance reruns every skippable finest run (its params change): choose it before they run.
 rule mpm_run:
     input:
         PACKAGE_SOURCES,
@@ -31,7 +33,7 @@ rule mpm_run:
     params:
         scene=lambda wc: MPM_RUNS[wc.run],
         skip_tolerance=lambda wc: SKIP_TOLERANCE if wc.run in SKIPPABLE else None,
-        sizes_um=lambda wc: list(matrix.particle_sizes_um(config)),
+        coarser_sizes_um=lambda wc: list(matrix.particle_sizes_um(config)[-3:-1]) if wc.run in SKIPPABLE else None,
     wildcard_constraints:
         run="|".join(re.escape(r) for r in MPM_RUNS) if MPM_RUNS else "NO_RUNS",
     threads: MPM_THREADS

@@ -22,7 +22,7 @@ def skipped(log) -> bool:
     if smk.params.skip_tolerance is None:
         return False
     coarse, mid = (xr.load_dataset(p) for p in smk.input.coarser)
-    h_coarse, h_mid = smk.params.sizes_um[-3], smk.params.sizes_um[-2]
+    h_coarse, h_mid = smk.params.coarser_sizes_um
     ex = skipping.two_size_extrapolation(coarse, mid, h_coarse, h_mid)
     print(f"two-size extrapolation of h = {h_coarse:g}, {h_mid:g} um: {ex}", file=log)
     if not skipping.should_skip(ex, smk.params.skip_tolerance):

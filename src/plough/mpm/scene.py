@@ -452,7 +452,7 @@ class Scene:
         particle size, CFL number and transfer are kept. ``benchmarks/work_precision.py`` runs it
         beside the defaults."""
         return replace(self, domain=PAPER_DOMAIN,
-                       sliding=replace(self.sliding, distance_m=600e-6, speed_m_s=0.1),
+                       sliding=replace(self.sliding, distance_m=600e-6, speed_m_s=0.1, stop_when_steady=False),
                        discretisation=replace(self.discretisation, mass_scaling=1e6),
                        outputs=replace(self.outputs, steady_window=(0.5, 1.0)))
 

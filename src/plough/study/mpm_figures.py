@@ -14,7 +14,7 @@ Coordinates are the config's values (never float arithmetic), so datasets align 
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Collection, Mapping
 from pathlib import Path
 from typing import Any
 
@@ -63,7 +63,9 @@ def load_runs(run_ids: list[str], paths: Mapping[str, str | Path]) -> dict[str, 
 
 
 def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mapping[str, xr.Dataset],
-                   suffix: str) -> xr.Dataset:
+                   suffix: str, skippable: Collection[str] = ()) -> xr.Dataset:
+    """One panel's per-size values and their h -> 0 extrapolation. ``sizes_um`` descending; a run in
+    ``skippable`` (``matrix.skippable_runs``) may be a skip marker, any other marker is refused."""
     labels = [s.label for s in panel.series]
     ax_units, ax_long = matrix.AXES[panel.axis]
     coords = {
@@ -82,8 +84,10 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                 rid = matrix.run_id(point, h)
                 ds = runs[rid]
                 if is_skipped(ds):
-                    if h != min(sizes_um):
-                        raise ValueError(f"run {rid!r} is a skip marker but h = {h:g} um is not the finest size")
+                    if rid not in skippable:
+                        raise ValueError(f"run {rid!r} is a skip marker, but the config does not allow skipping it "
+                                         "(mpm.skip_finest_tolerance is null, fewer than three sizes, not the "
+                                         "finest size, or a picture's run); delete the file and rerun")
                     skipped[i, j] = True
                     continue
                 for o in per_size:
@@ -103,8 +107,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
             continue
         ex = extrapolate_dataarray(da, "h")
         # points whose finest run was skipped: the two coarser sizes' extrapolation (flagged)
-        ex_coarse = extrapolate_dataarray(da.sel(h=[x for x in sizes_um if x != min(sizes_um)]), "h") \
-            if skipped.any() else ex
+        ex_coarse = extrapolate_dataarray(da.sel(h=list(sizes_um[-3:-1])), "h") if skipped.any() else ex
         for field in ("value", "uncertainty", "order", "method", "flagged"):
             name = f"{o}_h0{suffix}" if field == "value" else f"{o}_h0_{field}{suffix}"
             var = ex[field].copy(data=np.where(skipped, ex_coarse[field].values, ex[field].values))
@@ -129,7 +132,8 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
 def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
     panels = matrix.figure_panels(config, figure)
     sizes = matrix.particle_sizes_um(config)
-    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "") for p in panels]
+    skippable = set(matrix.skippable_runs(config))
+    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", skippable) for p in panels]
     ds = xr.merge(parts, combine_attrs="drop_conflicts", join="exact")
     ds.attrs["panels"] = ",".join(p.name for p in panels)
     if figure in ("fig11", "fig13"):
