@@ -8,7 +8,9 @@ assumed order 1 and Roache's safety factor 3). If that extrapolation's uncertain
 tolerance of its value for every steady-state output in :data:`CHECKED` the finest run is not
 made: its result file is a *skip marker* (no result variables; attributes say why, with the two
 extrapolations), and the figure dataset extrapolates that point from the two coarser sizes, flagged
-``TWO_SIZES_ASSUMED_ORDER``. Pictures (the single-run figures) always use a real finest run.
+``TWO_SIZES_ASSUMED_ORDER`` (``CONVERGED``, not flagged, when the two agree exactly). Pictures
+(the single-run figures) always use a real finest run. A marker where the config does not allow
+skipping that run is refused by the dataset builder.
 
 Default off (``null``): the faithful reproduction runs every size.
 """
