@@ -89,7 +89,11 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
     if x_hi <= x_lo:
         raise ValueError("the slide is too short to measure a residual groove behind the sphere "
                          "(sliding.distance_m must exceed ~2.7 contact radii)")
-    sections = np.linspace(x_lo, x_hi, scene.outputs.profile_sections)
+    # every particle row (bands of width h, adjacent) unless a number of sections is asked for: five
+    # one-row sections left dp at h = 10 um to the particle lattice (it moved +55% with the block
+    # length, +131% with CFL 0.6, mu within 3%); every row moved it -0.3% and +2.8%
+    n_sections = scene.outputs.profile_sections or int(np.floor((x_hi - x_lo) / h)) + 1
+    sections = np.linspace(x_lo, x_hi, n_sections) if n_sections > 1 else np.array([0.5 * (x_lo + x_hi)])
     edges = _y_edges(scene)
     centres = 0.5 * (edges[1:] + edges[:-1])
     top = p.x[:, 2] + 0.5 * h * np.cbrt(p.J)  # the top face of each particle's cube

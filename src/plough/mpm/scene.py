@@ -233,12 +233,14 @@ class Discretisation:
 @dataclass(frozen=True)
 class Outputs:
     """What a run records. ``steady_window`` is the fraction of the slide averaged for the
-    steady-state results (paper: the last half, 0.3-0.6 mm of 0.6 mm)."""
+    steady-state results (paper: the last half, 0.3-0.6 mm of 0.6 mm). ``profile_sections``: the
+    residual cross-sections averaged for dg, hpu, dp (0, the default: every particle row between
+    the start of the steady window and 1.25 contact radii behind the sphere)."""
 
     steady_window: tuple[float, float] = (0.5, 1.0)
     records: int = 400
     snapshots: int = 0
-    profile_sections: int = 5
+    profile_sections: int = 0
     taylor_quinney: float = 0.9
     initial_temperature_K: float = ROOM_TEMPERATURE_K
     buried_profile_depth_m: float = 15e-6
@@ -251,8 +253,9 @@ class Outputs:
             raise ValueError(f"outputs.records = {self.records!r} must be >= 10")
         if self.snapshots < 0:
             raise ValueError(f"outputs.snapshots = {self.snapshots!r} must be >= 0")
-        if self.profile_sections < 1:
-            raise ValueError(f"outputs.profile_sections = {self.profile_sections!r} must be >= 1")
+        if self.profile_sections < 0:
+            raise ValueError(f"outputs.profile_sections = {self.profile_sections!r} must be >= 0 "
+                             "(0: every particle row between the limits)")
         if not (math.isfinite(self.buried_profile_depth_m) and self.buried_profile_depth_m > 0):
             raise ValueError(f"outputs.buried_profile_depth_m = {self.buried_profile_depth_m!r} m must be > 0")
         if not (0 <= self.taylor_quinney <= 1):
