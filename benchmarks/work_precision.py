@@ -252,13 +252,20 @@ def main() -> None:
     if not args.plot_only:
         from plough.study.cost import estimate
 
-        # cheapest first: the picture fills in early and an interruption loses the least
-        for name, make in sorted(cases.items(), key=lambda kv: estimate(kv[1]()).particle_steps):
+        todo = {}
+        for name, make in cases.items():
             if name in runs or (args.only is not None and name not in args.only):
                 continue
             try:
-                runs[name] = run_one(make(), args.threads)
-            except ValueError as exc:  # a refused scene is a result too
+                todo[name] = make()
+            except ValueError as exc:  # a scene refused before running is a result too
+                data.setdefault("refused", {})[name] = str(exc)
+                print(f"{name}: refused: {exc}", flush=True)
+        # cheapest first: the picture fills in early and an interruption loses the least
+        for name, scene_ in sorted(todo.items(), key=lambda kv: estimate(kv[1]).particle_steps):
+            try:
+                runs[name] = run_one(scene_, args.threads)
+            except ValueError as exc:
                 data.setdefault("refused", {})[name] = str(exc)
                 print(f"{name}: refused: {exc}", flush=True)
                 continue
