@@ -135,7 +135,7 @@ def test_smoke_skip_finest_writes_markers_where_the_coarser_sizes_agree(tmp_path
     skippable = matrix.skippable_runs(cfg)
     spread = sorted(worst(s) for r, s in zip(finest_ids, stems, strict=True) if r in skippable)
     assert len(spread) >= 2 and spread[0] < spread[-1]
-    tol = min(0.5 * (spread[0] + spread[-1]), 0.99)
+    tol = 0.5 * (spread[0] + spread[-1])  # the smoke sizes are coarse: this may exceed 1
     cfg["mpm"]["skip_finest_tolerance"] = tol
     (work / "config" / "smoke.yaml").write_text(yaml.safe_dump(cfg))
     out = _snakemake(work, "--configfile=config/smoke.yaml", "results/datasets/fig15.nc")

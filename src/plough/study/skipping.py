@@ -45,8 +45,8 @@ def two_size_extrapolation(coarse: xr.Dataset, mid: xr.Dataset, h_coarse_um: flo
 
 def should_skip(extrapolations: dict[str, dict[str, float]], tolerance: float) -> bool:
     """True when every checked output's relative uncertainty is within ``tolerance``."""
-    if not (np.isfinite(tolerance) and 0 < tolerance < 1):
-        raise ValueError(f"mpm.skip_finest_tolerance = {tolerance!r} is outside the allowed range (0, 1)")
+    if not (np.isfinite(tolerance) and tolerance > 0):
+        raise ValueError(f"mpm.skip_finest_tolerance = {tolerance!r} must be a finite number > 0")
     return all(np.isfinite(e["relative_uncertainty"]) and e["relative_uncertainty"] <= tolerance
                for e in extrapolations.values())
 
