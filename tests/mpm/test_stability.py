@@ -46,8 +46,14 @@ def assert_bounded(s: Scene, *, energy: bool) -> None:
 
 
 def test_cfl_at_the_accepted_maximum_completes_bounded():
-    """CFL 1.0: stable (measured mu 0.524, Fz / load 1.15, energy 1.13 against 0.571 / 0.95 / 0.96 at 0.3)."""
-    assert_bounded(scene(discretisation={"cfl": 1.0}), energy=True)
+    """CFL 1.0: stable, but the energy terms over-count (measured mu 0.439, Fz / load 1.20, energy terms
+    1.28 x the work, against 0.480 / 0.95 / 1.02 at CFL 0.3): no energy claim here."""
+    assert_bounded(scene(discretisation={"cfl": 1.0}), energy=False)
+
+
+def test_cfl_0_6_keeps_the_energy_balance():
+    """CFL 0.6: the largest tested CFL whose energy terms stay within 15% of the work (measured 1.13)."""
+    assert_bounded(scene(discretisation={"cfl": 0.6}), energy=True)
 
 
 def test_bulk_coating_200_um_completes_bounded():
