@@ -84,7 +84,9 @@ def _add_mpm(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--snapshots", default=None, help="directory for particle snapshots (.vtp)")
     p.add_argument("--threads", type=int, default=None, help="numba threads (default: all cores)")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
-    p.add_argument("--preset", default=None, choices=["paper", "sized"],
+    from plough.mpm.scene import PRESETS  # light: no numba
+
+    p.add_argument("--preset", default=None, choices=PRESETS,
                    help="paper: the paper's 0.2 x 1 mm block, 0.6 mm slide, 0.1 m/s, mass scaling 1e6; "
                    "sized: the block sized from the expected contact radius")
     p.set_defaults(func=_run_mpm)

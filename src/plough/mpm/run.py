@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from plough.mpm import contact, io, solver, transfers
-from plough.mpm.scene import Scene
+from plough.mpm.scene import PRESETS, Scene
 
 
 class _Recorder:
@@ -169,10 +169,6 @@ def _update_bar(bar, state: solver.State, rec: _Recorder) -> None:
         last = rec.rows[-1]
         bar.set_postfix_str(f"Fx={last['Fx']:.3g} N Fz={last['Fz']:.3g} N step={state.step}", refresh=False)
     bar.update(slid_um - bar.n)
-
-
-#: Named numerical presets a scene file can be run with (``plough mpm --preset``).
-PRESETS = ("paper", "sized")
 
 
 def apply_preset(scene: Scene, preset: str | None) -> Scene:

@@ -151,6 +151,10 @@ class Domain:
             raise ValueError(f"domain.symmetric = {self.symmetric!r} must be true or false")
 
 
+#: Named numerical presets a scene file can be run with (``plough mpm --preset``,
+#: ``plough.mpm.run.apply_preset``): the paper's setup, or the block sized from the contact.
+PRESETS = ("paper", "sized")
+
 #: The paper's block: a half cylinder of radius 0.2 mm and length 1 mm, mirror plane at y = 0.
 PAPER_DOMAIN = Domain(radius_m=200e-6, length_m=1000e-6, symmetric=True)
 
