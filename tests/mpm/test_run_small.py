@@ -27,7 +27,9 @@ from plough.mpm.scene import Scene
 
 TINY = {
     "name": "tiny",
-    "load_N": 1.0,
+    # 1.5 N, not 1 N: with the projected dilatation the 1 N scene (penetration 0.3 um, a thirtieth of a
+    # particle) swings by 40% of the load over 5 um of sliding and its window mean was 7.5% low
+    "load_N": 1.5,
     "sphere": {"radius_um": 200},
     "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
     "interface": {"model": "proportional", "f": 1.0},

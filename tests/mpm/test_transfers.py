@@ -119,10 +119,15 @@ def test_apic_p2g_conserves_angular_momentum():
 
 # ----------------------------------------------------------------------------- affine field
 def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=None, sphere_r=1e-6,
-            near_dist=3 * DX, grid_lo=None, grid_hi=None, table=STIFF, flip=0.0):
+            near_dist=3 * DX, grid_lo=None, grid_hi=None, table=STIFF, flip=0.0, project=0):
     n = x.shape[0]
     if grid_v.shape[1] == 3:  # no FLIP increment: the old velocity equals the new one
         grid_v = np.hstack([grid_v, grid_v])
+    grid_div = np.zeros(grid_v.shape[0])
+    if project:
+        buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
+        tr.p2g_dilatation(grid_v, ORIGIN, DX, SHAPE, x, mass, buf)
+        tr.grid_dilatation(buf, grid_div, SHAPE, -1)
     eps_p = np.zeros(n)
     temperature = np.full(n, 298.0)
     mat = np.zeros(n, dtype=np.int32)
@@ -134,7 +139,8 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     lo = ORIGIN + DX if grid_lo is None else grid_lo
     hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
     tr.g2p(grid_v, ORIGIN, DX, dt, SHAPE, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat, mat, frac,
-           table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, flip)
+           table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, flip, grid_div, project,
+           tr.allocate_velocity_gradient_scratch(n_chunks))
     return acc, near, eps_p
 
 
@@ -435,3 +441,127 @@ def test_g2p_blends_the_flip_increment_with_the_grid_velocity(flip):
     np.testing.assert_allclose(x, x0 + 1e-7 * v_pic, rtol=0, atol=1e-18)
     if flip > 0:
         assert np.abs(v - v_pic).max() > 1e-3  # the particles keep what the grid cannot hold
+
+
+# ----------------------------------------------------------------------------- dilatation projection
+def weights_reference(x, origin=ORIGIN, dx=DX, shape=SHAPE):
+    """Slow reference: the 27 node indices and quadratic B-spline weights of each particle."""
+    g = (x - origin) / dx
+    base = np.floor(g - 0.5).astype(int)
+    f = g - base
+    w1d = np.stack([0.5 * (1.5 - f) ** 2, 0.75 - (f - 1.0) ** 2, 0.5 * (f - 0.5) ** 2], axis=-1)  # (n, 3, 3)
+    nodes, weights = [], []
+    for a in range(3):
+        for b in range(3):
+            for c in range(3):
+                idx = ((base[:, 0] + a) * shape[1] + base[:, 1] + b) * shape[2] + base[:, 2] + c
+                nodes.append(idx)
+                weights.append(w1d[:, 0, a] * w1d[:, 1, b] * w1d[:, 2, c])
+    return np.stack(nodes, axis=1), np.stack(weights, axis=1)
+
+
+def projection_reference(grid_v, x, mass):
+    """Per particle: tr L_p, the lumped projection d_i = sum w m tr / m_i and d_bar_p = sum w d_i."""
+    nodes, w = weights_reference(x)
+    rel = node_positions()[nodes] - x[:, None, :]  # (n, 27, 3)
+    tr_p = 4.0 / DX**2 * np.einsum("pk,pkd,pkd->p", w, grid_v[nodes, :3], rel)
+    n_nodes = grid_v.shape[0]
+    m_i = np.bincount(nodes.ravel(), (w * mass[:, None]).ravel(), n_nodes)
+    mt_i = np.bincount(nodes.ravel(), (w * (mass * tr_p)[:, None]).ravel(), n_nodes)
+    d_i = np.divide(mt_i, m_i, out=np.zeros(n_nodes), where=m_i > 0)
+    return tr_p, d_i, (w * d_i[nodes]).sum(1)
+
+
+@pytest.mark.parametrize("n_chunks", [1, 3])
+def test_dilatation_projection_matches_reference_and_conserves_volume_change(n_chunks):
+    """The kernels give the slow reference's nodal field, and sum_p m_p d_bar_p = sum_p m_p tr L_p."""
+    rng, x, _, _, _, mass = random_particles(n=500, seed=11)
+    grid_v = rng.normal(0.0, 0.1, (int(np.prod(SHAPE)), 6))
+    buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
+    buf[:] = 1.0  # stale content must not leak in
+    grid_div = np.full(grid_v.shape[0], np.nan)
+    tr.p2g_dilatation(grid_v, ORIGIN, DX, SHAPE, x, mass, buf)
+    tr.grid_dilatation(buf, grid_div, SHAPE, -1)
+    tr_p, d_i, d_bar = projection_reference(grid_v, x, mass)
+    scale = np.abs(d_i).max()
+    np.testing.assert_allclose(grid_div, d_i, rtol=0, atol=1e-12 * scale)
+    assert (mass * d_bar).sum() == pytest.approx((mass * tr_p).sum(), rel=1e-10, abs=1e-12 * scale * mass.sum())
+    # both steps are weighted means, so (Jensen) the mass-weighted norm can only shrink; a random field shrinks
+    assert (mass * d_bar**2).sum() < 0.9 * (mass * tr_p**2).sum()
+
+
+def test_g2p_with_projection_moves_J_with_the_projected_dilatation_and_keeps_the_deviator():
+    rng, x, _, vol0, J0, mass = random_particles(n=400, seed=12)
+    n = x.shape[0]
+    grid_v = np.hstack([rng.normal(0.0, 0.05, (int(np.prod(SHAPE)), 3))] * 2)
+    dt = 1e-7
+    tr_p, _, d_bar = projection_reference(grid_v, x, mass)
+    runs = {}
+    for project in (0, 1):
+        xs, C, stress, J = x.copy(), np.zeros((n, 3, 3)), np.zeros((n, 6)), J0.copy()
+        run_g2p(grid_v, xs, np.zeros((n, 3)), C, stress, J, vol0, mass, dt, n_chunks=2, project=project)
+        runs[project] = (xs, C, stress, J)
+    (x0, C0, s0, J_local), (x1, C1, s1, J_proj) = runs[0], runs[1]
+    np.testing.assert_array_equal(x0, x1)  # advection and the stored velocity gradient are L's
+    np.testing.assert_array_equal(C0, C1)
+    L_bar = C0 + ((d_bar - tr_p) / 3.0)[:, None, None] * np.eye(3)
+    np.testing.assert_allclose(J_proj, J0 * np.linalg.det(np.eye(3) + dt * L_bar), rtol=1e-12)
+    assert np.abs(J_proj / J_local - 1).max() > 1e-6  # the projection acts on this random field
+    K = STIFF[0, I_K]
+    np.testing.assert_allclose(s1[:, :3].mean(1), K * (J_proj - 1.0), rtol=1e-9)  # pressure from J_bar
+    dev0, dev1 = s0[:, :3] - s0[:, :3].mean(1, keepdims=True), s1[:, :3] - s1[:, :3].mean(1, keepdims=True)
+    np.testing.assert_allclose(dev1, dev0, rtol=0, atol=1e-9 * np.abs(dev0).max())
+    np.testing.assert_allclose(s1[:, 3:], s0[:, 3:], rtol=0, atol=1e-9 * np.abs(s0[:, 3:]).max())
+
+
+def test_uniform_dilatation_passes_the_projection_unchanged():
+    """An affine velocity field has the same tr L at every particle: projecting it changes nothing."""
+    rng, x, _, vol0, J0, mass = random_particles(n=300, seed=13)
+    n = x.shape[0]
+    A = rng.normal(0.0, 1e3, (3, 3))
+    grid_v = node_positions() @ A.T
+    out = {}
+    for project in (0, 1):
+        J = J0.copy()
+        stress = np.zeros((n, 6))
+        run_g2p(grid_v, x.copy(), np.zeros((n, 3)), np.zeros((n, 3, 3)), stress, J, vol0, mass, 1e-7,
+                project=project)
+        out[project] = (J, stress)
+    np.testing.assert_allclose(out[1][0], out[0][0], rtol=1e-13)
+    np.testing.assert_allclose(out[1][1], out[0][1], rtol=1e-9, atol=1e-6)
+
+
+def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain():
+    """Half domain (mirror fold) and full domain with mirrored particles give the same nodal field."""
+    rng = np.random.default_rng(8)
+    dx = 1e-5
+    half_grid = make_grid(2e-4, 8e-5, True, dx, 3e-5)
+    full_grid = make_grid(2e-4, 8e-5, False, dx, 3e-5)
+    n = 300
+    x = np.column_stack([rng.uniform(3e-5, 1.7e-4, n), rng.uniform(0.0, 5e-5, n), rng.uniform(-6e-5, 0.0, n)])
+    mass = RHO * (0.5 * dx) ** 3 * rng.uniform(0.8, 1.2, n)
+
+    def velocity(pos):  # a smooth field even in y for v_x, v_z and odd for v_y
+        return np.column_stack([np.sin(pos[:, 0] / 4e-5) * np.cos(pos[:, 1] / 3e-5), np.sin(pos[:, 1] / 2e-5),
+                                np.cos(pos[:, 2] / 5e-5 + pos[:, 1] ** 2 / 1e-9)])
+
+    def project(grid, xs, ms, symmetric):
+        shape = np.array(grid.shape, dtype=np.int64)
+        gv = np.hstack([velocity(grid.node_positions())] * 2)
+        buf = tr.allocate_grid_buffers(2, grid.n_nodes)
+        out = np.zeros(grid.n_nodes)
+        tr.p2g_dilatation(gv, grid.origin, dx, shape, xs, ms, buf)
+        tr.grid_dilatation(buf, out, shape, mirror_plane_index(grid, symmetric))
+        return out
+
+    d_h = project(half_grid, x, mass, True)
+    d_f = project(full_grid, np.vstack([x, x * [1.0, -1.0, 1.0]]), np.concatenate([mass, mass]), False)
+    index_f = {tuple(np.round(q / dx).astype(int)): i for i, q in enumerate(full_grid.node_positions())}
+    checked = 0
+    for i, q in enumerate(half_grid.node_positions()):
+        j = index_f.get(tuple(np.round(q / dx).astype(int)))
+        if j is None or d_f[j] == 0.0:
+            continue
+        checked += 1
+        assert d_h[i] == pytest.approx(d_f[j], rel=1e-9, abs=1e-9 * np.abs(d_f).max())
+    assert checked > 100

@@ -8,8 +8,10 @@ One step (model.md section 2):
 3. Contact: the rigid sphere on the nodes inside it, traction-limited interface shear (eq. 8);
    the reaction is the force on the sphere.
 4. Sphere motion: pressing, then sliding along x; its height floats under load control.
-5. G2P: velocities (APIC blended with the FLIP increment) and velocity gradients back to the
-   particles, stress update (eqs. 6.1-6.2, 7.1-7.3), advection, instability checks.
+5. Dilatation projection: the volumetric strain rate to the grid and back (anti-locking).
+6. G2P: velocities (APIC blended with the FLIP increment) and velocity gradients back to the
+   particles, stress update (eqs. 6.1-6.2, 7.1-7.3) with the projected dilatation, advection,
+   instability checks.
 
 The time step is dt = CFL dx / c with c = sqrt((K + 4G/3) / (ms rho)) the mass-scaled elastic
 wave speed.
@@ -83,6 +85,7 @@ class Constants:
     control_gain: float  # m/s per N
     contact_alpha: float  # weight of one step in the per-node contact-force filter
     flip: float  # FLIP share of the particle velocity update (0 = APIC)
+    project_dilatation: int  # 1: J and pressure from the grid-projected dilatation rate
     filter_alpha: float
     control: str
     target_depth: float | None
@@ -105,6 +108,8 @@ class Work:
     last_contact: np.ndarray  # per-node step of the last contact
     acc: np.ndarray
     contact_out: np.ndarray
+    grid_div: np.ndarray  # projected nodal dilatation rate, 1/s
+    L_buf: np.ndarray  # per-chunk scratch for the projected velocity gradient
     external_work: float = 0.0
     plastic_work: float = 0.0
     interface_dissipation: float = 0.0
@@ -169,7 +174,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         press_speed=scene.sliding.press_speed_fraction * scene.sliding.speed_m_s,
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
-        flip=disc.flip, contact_alpha=min(dt / (contact.FILTER_WAVE_TIMES * dx / c), 1.0),
+        flip=disc.flip, project_dilatation=int(disc.dilatation == "projected"), contact_alpha=min(dt / (contact.FILTER_WAVE_TIMES * dx / c), 1.0),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
         shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
@@ -180,7 +185,8 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
         cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), fn_filtered=np.zeros(grid.n_nodes),
         last_contact=np.full(grid.n_nodes, -2, dtype=np.int64), acc=np.zeros((n_chunks, transfers.N_ACC)),
-        contact_out=np.zeros(contact.N_OUT),
+        contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
+        L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks),
     )
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
     return State(particles=particles, sphere=sphere, work=work), const
@@ -214,9 +220,13 @@ def step(s: State, c: Constants) -> None:
     if c.mirror_j0 >= 0:
         transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0)
     move_sphere(sph, c)
+    if c.project_dilatation:
+        transfers.p2g_dilatation(w.grid_v, g.origin, g.dx, c.shape, p.x, p.mass, w.grid_buf)
+        transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0)
     transfers.g2p(w.grid_v, g.origin, g.dx, c.dt, c.shape, p.x, p.v, p.C, p.stress, p.J, p.vol0, p.mass, p.eps_p,
                   p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney, sph.centre,
-                  c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, c.flip)
+                  c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, c.flip, w.grid_div,
+                  c.project_dilatation, w.L_buf)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
