@@ -124,9 +124,10 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     if grid_v.shape[1] == 3:  # no FLIP increment: the old velocity equals the new one
         grid_v = np.hstack([grid_v, grid_v])
     grid_div = np.zeros(grid_v.shape[0])
+    v_grid = np.zeros((n, 3))
+    buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
+    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, v, C, v_grid, mass, flip, buf, project)
     if project:
-        buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
-        tr.p2g_dilatation(grid_v, ORIGIN, DX, SHAPE, x, mass, buf)
         tr.grid_dilatation(buf, grid_div, SHAPE, -1)
     eps_p = np.zeros(n)
     temperature = np.full(n, 298.0)
@@ -138,9 +139,9 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
         sphere_c = np.array([1.0, 1.0, 1.0])  # far away
     lo = ORIGIN + DX if grid_lo is None else grid_lo
     hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
-    tr.g2p(grid_v, ORIGIN, DX, dt, SHAPE, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat, mat, frac,
-           table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, flip, grid_div, project,
-           tr.allocate_velocity_gradient_scratch(n_chunks))
+    tr.g2p_update(ORIGIN, DX, dt, SHAPE, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, mat, mat, frac,
+                  table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, grid_div, project,
+                  tr.allocate_velocity_gradient_scratch(n_chunks))
     return acc, near, eps_p
 
 
@@ -480,7 +481,9 @@ def test_dilatation_projection_matches_reference_and_conserves_volume_change(n_c
     buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
     buf[:] = 1.0  # stale content must not leak in
     grid_div = np.full(grid_v.shape[0], np.nan)
-    tr.p2g_dilatation(grid_v, ORIGIN, DX, SHAPE, x, mass, buf)
+    n = x.shape[0]
+    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros((n, 3)), mass,
+                      0.0, buf, 1)
     tr.grid_dilatation(buf, grid_div, SHAPE, -1)
     tr_p, d_i, d_bar = projection_reference(grid_v, x, mass)
     scale = np.abs(d_i).max()
@@ -550,7 +553,9 @@ def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain(
         gv = np.hstack([velocity(grid.node_positions())] * 2)
         buf = tr.allocate_grid_buffers(2, grid.n_nodes)
         out = np.zeros(grid.n_nodes)
-        tr.p2g_dilatation(gv, grid.origin, dx, shape, xs, ms, buf)
+        k = len(xs)
+        tr.g2p_kinematics(gv, grid.origin, dx, shape, xs, np.zeros((k, 3)), np.zeros((k, 3, 3)), np.zeros((k, 3)), ms,
+                          0.0, buf, 1)
         tr.grid_dilatation(buf, out, shape, mirror_plane_index(grid, symmetric))
         return out
 

@@ -8,9 +8,9 @@ One step (model.md section 2):
 3. Contact: the rigid sphere on the nodes inside it, traction-limited interface shear (eq. 8);
    the reaction is the force on the sphere.
 4. Sphere motion: pressing, then sliding along x; its height floats under load control.
-5. Dilatation projection: the volumetric strain rate to the grid and back (anti-locking).
-6. G2P: velocities (APIC blended with the FLIP increment) and velocity gradients back to the
-   particles, stress update (eqs. 6.1-6.2, 7.1-7.3) with the projected dilatation, advection,
+5. G2P: velocities (APIC blended with the FLIP increment) and velocity gradients back to the
+   particles; their dilatation rates to the grid and back (the projection against volumetric
+   locking); stress update (eqs. 6.1-6.2, 7.1-7.3) with the projected dilatation, advection,
    instability checks.
 
 The time step is dt = CFL dx / c with c = sqrt((K + 4G/3) / (ms rho)) the mass-scaled elastic
@@ -110,6 +110,7 @@ class Work:
     contact_out: np.ndarray
     grid_div: np.ndarray  # projected nodal dilatation rate, 1/s
     L_buf: np.ndarray  # per-chunk scratch for the projected velocity gradient
+    v_grid: np.ndarray  # (n, 3) grid velocity at each particle, m/s: what it is advected with
     external_work: float = 0.0
     plastic_work: float = 0.0
     interface_dissipation: float = 0.0
@@ -187,7 +188,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), fn_filtered=np.zeros(grid.n_nodes),
         last_contact=np.full(grid.n_nodes, -2, dtype=np.int64), acc=np.zeros((n_chunks, transfers.N_ACC)),
         contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
-        L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks),
+        L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
     )
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
     return State(particles=particles, sphere=sphere, work=work), const
@@ -221,13 +222,14 @@ def step(s: State, c: Constants) -> None:
     if c.mirror_j0 >= 0:
         transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0)
     move_sphere(sph, c)
+    transfers.g2p_kinematics(w.grid_v, g.origin, g.dx, c.shape, p.x, p.v, p.C, w.v_grid, p.mass, c.flip, w.grid_buf,
+                             c.project_dilatation)
     if c.project_dilatation:
-        transfers.p2g_dilatation(w.grid_v, g.origin, g.dx, c.shape, p.x, p.mass, w.grid_buf)
         transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0)
-    transfers.g2p(w.grid_v, g.origin, g.dx, c.dt, c.shape, p.x, p.v, p.C, p.stress, p.J, p.vol0, p.mass, p.eps_p,
-                  p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney, sph.centre,
-                  c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, c.flip, w.grid_div,
-                  c.project_dilatation, w.L_buf)
+    transfers.g2p_update(g.origin, g.dx, c.dt, c.shape, p.x, p.v, w.v_grid, p.C, p.stress, p.J, p.vol0, p.mass,
+                         p.eps_p, p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney,
+                         sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, w.grid_div,
+                         c.project_dilatation, w.L_buf)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)

@@ -200,58 +200,8 @@ def mirror_ghosts(grid_v, flags, shape, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def p2g_dilatation(grid_v, origin, dx, shape, x, mass, grid_buf):
-    """Scatter each particle's mass and mass-weighted dilatation rate tr L_p to per-chunk grid copies.
-
-    Reads grid_v[:, 0:3] (the velocity at the end of the step, after contact) and particle x, mass.
-    Writes grid_buf[c, node, 0] = sum w m and grid_buf[c, node, 1] = sum w m tr L over chunk c's
-    particles, zeroing those two channels first (the P2G content is no longer needed). Race-free:
-    chunk c owns grid_buf[c].
-    """
-    n = x.shape[0]
-    n_chunks = grid_buf.shape[0]
-    ny, nz = shape[1], shape[2]
-    inv_dx = 1.0 / dx
-    dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
-    for c in prange(n_chunks):
-        buf = grid_buf[c]
-        buf[:, 0:2] = 0.0
-        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
-            gx = (x[p, 0] - origin[0]) * inv_dx
-            gy = (x[p, 1] - origin[1]) * inv_dx
-            gz = (x[p, 2] - origin[2]) * inv_dx
-            bx, wx0, wx1, wx2 = bspline2(gx)
-            by, wy0, wy1, wy2 = bspline2(gy)
-            bz, wz0, wz1, wz2 = bspline2(gz)
-            tr = 0.0
-            for a in range(3):
-                wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
-                d0 = (bx + a - gx) * dx
-                for b in range(3):
-                    wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
-                    d1 = (by + b - gy) * dx
-                    row = ((bx + a) * ny + (by + b)) * nz + bz
-                    for cc in range(3):
-                        w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
-                        d2 = (bz + cc - gz) * dx
-                        node = row + cc
-                        tr += w * (grid_v[node, 0] * d0 + grid_v[node, 1] * d1 + grid_v[node, 2] * d2)
-            wm = mass[p]
-            wt = wm * dinv * tr
-            for a in range(3):
-                wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
-                for b in range(3):
-                    wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
-                    row = ((bx + a) * ny + (by + b)) * nz + bz
-                    for cc in range(3):
-                        w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
-                        buf[row + cc, 0] += w * wm
-                        buf[row + cc, 1] += w * wt
-
-
-@njit(cache=True, parallel=True)
 def grid_dilatation(grid_buf, grid_div, shape, mirror_j0):
-    """Sum the chunk copies of ``p2g_dilatation`` into the nodal dilatation rate d_i = (sum w m d) / m_i.
+    """Nodal dilatation rate d_i = (sum w m d) / m_i from the chunk copies of the ``g2p_kinematics`` scatter.
 
     Reads grid_buf[:, :, 0:2]; writes grid_div[node] (0 where no mass). With the mirror plane a
     node also sums its ghost's contributions (the dilatation is even in y), so ghost and partner
@@ -278,34 +228,25 @@ def grid_dilatation(grid_buf, grid_div, shape, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, temperature, mat_a, mat_b,
-        frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo, grid_hi, flip,
-        grid_div, project, L_buf):
-    """Gather velocities, update stress (eq. 6.1-6.2), advect, and check the particle state.
+def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_buf, scatter_dilatation):
+    """Gather the particle velocities and velocity gradients; scatter the dilatation for its projection.
 
-    Reads grid_v (0:3 new, 3:6 before the internal force), the particle velocity v (FLIP
-    share ``flip``), the sphere (centre sphere_c after this step, radius sphere_r) and, if
-    ``project`` is 1, the projected nodal dilatation grid_div (``grid_dilatation``): J and the
-    pressure then follow L_bar = C + (sum w d_i - tr C) I / 3, formed in the chunk's scratch
-    L_buf[c]; with ``project`` 0 they follow C (grid_div and L_buf are not read). Writes particle
-    v, C, J, x, stress, eps_p, temperature, near (1 if within near_dist of the sphere surface),
-    and per-chunk accumulators acc[c, :] (plastic work, kinetic and elastic energy, adiabatic
-    heat, deepest penetration of a particle centre into the sphere, worst instability code and
-    the particle showing it). Each particle writes only its own entries.
+    Reads grid_v (0:3 new, 3:6 before the internal force), particle x, v (FLIP share ``flip``),
+    mass. Writes particle v (the blended update), C (= L_p, the APIC velocity gradient) and v_grid
+    (sum_i w v_i, the velocity the particle is advected with). If ``scatter_dilatation`` is 1 also
+    writes grid_buf[c, node, 0] = sum w m and grid_buf[c, node, 1] = sum w m tr L over chunk c's
+    particles (zeroing those two channels first; the P2G content is no longer needed), for
+    ``grid_dilatation``. Race-free: particle p writes only its own entries, chunk c only grid_buf[c].
     """
     n = x.shape[0]
-    n_chunks = acc.shape[0]
+    n_chunks = grid_buf.shape[0]
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
-        wp_sum = 0.0
-        ke_sum = 0.0
-        el_sum = 0.0
-        heat_sum = 0.0
-        pen_max = -1e300
-        bad = BAD_NONE
-        bad_p = -1
+        buf = grid_buf[c]
+        if scatter_dilatation:
+            buf[:, 0:2] = 0.0
         for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
             gx = (x[p, 0] - origin[0]) * inv_dx
             gy = (x[p, 1] - origin[1]) * inv_dx
@@ -328,7 +269,6 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
             b20 = 0.0
             b21 = 0.0
             b22 = 0.0
-            d_bar = 0.0
             for a in range(3):
                 wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
                 d0 = (bx + a - gx) * dx
@@ -358,11 +298,12 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
                         b20 += gv2 * d0
                         b21 += gv2 * d1
                         b22 += gv2 * d2
-                        if project:
-                            d_bar += w * grid_div[node]
             v[p, 0] = (1.0 - flip) * v0 + flip * (v[p, 0] + dv0)
             v[p, 1] = (1.0 - flip) * v1 + flip * (v[p, 1] + dv1)
             v[p, 2] = (1.0 - flip) * v2 + flip * (v[p, 2] + dv2)
+            v_grid[p, 0] = v0
+            v_grid[p, 1] = v1
+            v_grid[p, 2] = v2
             Cp = C[p]
             Cp[0, 0] = dinv * b00
             Cp[0, 1] = dinv * b01
@@ -373,10 +314,54 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
             Cp[2, 0] = dinv * b20
             Cp[2, 1] = dinv * b21
             Cp[2, 2] = dinv * b22
+            if scatter_dilatation:
+                wm = mass[p]
+                wt = wm * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2])
+                for a in range(3):
+                    wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
+                    for b in range(3):
+                        wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
+                        row = ((bx + a) * ny + (by + b)) * nz + bz
+                        for cc in range(3):
+                            w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
+                            buf[row + cc, 0] += w * wm
+                            buf[row + cc, 1] += w * wt
+
+
+@njit(cache=True, parallel=True)
+def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, mat_a, mat_b,
+               frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo, grid_hi,
+               grid_div, project, L_buf):
+    """Update the stress (eq. 6.1-6.2), advect, and check the particle state.
+
+    Reads particle v, v_grid and C (from ``g2p_kinematics``), the sphere (centre sphere_c after this
+    step, radius sphere_r) and, if ``project`` is 1, the projected nodal dilatation grid_div
+    (``grid_dilatation``): J and the pressure then follow L_bar = C + (sum w d_i - tr C) I / 3,
+    formed in the chunk's scratch L_buf[c]; with ``project`` 0 they follow C (grid_div and L_buf
+    are not read). Writes particle x (x += dt v_grid), J, stress, eps_p, temperature, near (1 if
+    within near_dist of the sphere surface), and per-chunk accumulators acc[c, :] (plastic work,
+    kinetic and elastic energy, adiabatic heat, deepest penetration of a particle centre into the
+    sphere, worst instability code and the particle showing it). Each particle writes only its own
+    entries.
+    """
+    n = x.shape[0]
+    n_chunks = acc.shape[0]
+    ny, nz = shape[1], shape[2]
+    inv_dx = 1.0 / dx
+    for c in prange(n_chunks):
+        wp_sum = 0.0
+        ke_sum = 0.0
+        el_sum = 0.0
+        heat_sum = 0.0
+        pen_max = -1e300
+        bad = BAD_NONE
+        bad_p = -1
+        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
+            Cp = C[p]
             L = Cp
             if project:
                 L = L_buf[c]
-                _with_dilatation(Cp, d_bar, L)
+                _with_dilatation(Cp, _gather_scalar(grid_div, x, p, origin, inv_dx, ny, nz), L)
             J_new = J[p] * _det_i_plus(dt, L)
             J[p] = J_new
             pa = table[mat_a[p]]
@@ -389,9 +374,9 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
             K, G = mixed_moduli(pa, pb, frac_a[p])
             el_sum += elastic_energy_density(stress, p, K, G) * vol
             ke_sum += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
-            x0 = x[p, 0] + dt * v0
-            x1 = x[p, 1] + dt * v1
-            x2 = x[p, 2] + dt * v2
+            x0 = x[p, 0] + dt * v_grid[p, 0]
+            x1 = x[p, 1] + dt * v_grid[p, 1]
+            x2 = x[p, 2] + dt * v_grid[p, 2]
             x[p, 0] = x0
             x[p, 1] = x1
             x[p, 2] = x2
@@ -421,6 +406,22 @@ def g2p(grid_v, origin, dx, dt, shape, x, v, C, stress, J, vol0, mass, eps_p, te
         acc[c, ACC_PENETRATION] = pen_max
         acc[c, ACC_BAD] = bad
         acc[c, ACC_BAD_INDEX] = bad_p
+
+
+@njit(cache=True, inline="always")
+def _gather_scalar(field, x, p, origin, inv_dx, ny, nz):
+    """sum_i w_ip field[i] at particle p (quadratic B-spline weights)."""
+    bx, wx0, wx1, wx2 = bspline2((x[p, 0] - origin[0]) * inv_dx)
+    by, wy0, wy1, wy2 = bspline2((x[p, 1] - origin[1]) * inv_dx)
+    bz, wz0, wz1, wz2 = bspline2((x[p, 2] - origin[2]) * inv_dx)
+    total = 0.0
+    for a in range(3):
+        wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
+        for b in range(3):
+            wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
+            row = ((bx + a) * ny + (by + b)) * nz + bz
+            total += wab * (wz0 * field[row] + wz1 * field[row + 1] + wz2 * field[row + 2])
+    return total
 
 
 @njit(cache=True, inline="always")
