@@ -19,7 +19,7 @@ import numba
 from plough import __version__
 from plough.analytical import ploughing
 from plough.io import git_commit
-from plough.mpm.run import simulate
+from plough.mpm.run import simulate, warm_up
 from plough.mpm.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -40,6 +40,8 @@ def main() -> None:
     Hc = 3.0 * base.layers.coating.flow.sigma_y_Pa if base.layers.coated else Hs
     ana = ploughing(base.load_N, base.sphere.radius_m, base.layers.coating_thickness_m, Hc, Hs, k1=args.k1)
     rows = []
+    # compile (or load from numba's cache) first: the first run's wall time would include it
+    print(f"warm-up (compilation, not timed below): {warm_up(args.threads):.1f} s")
     print("| h (um) | particles | steps | wall (s) | M particle-steps/s | mu | mu_pl | mu_sh | dp (um) | "
           "penetration (um) | Fz mean / load |")
     print("|---|---|---|---|---|---|---|---|---|---|---|")
