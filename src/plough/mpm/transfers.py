@@ -113,6 +113,18 @@ def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf):
                         buf[node, 6] += w * k_stress * (s[4] * d0 + s[3] * d1 + s[2] * d2)
 
 
+@njit(cache=True, inline="always")
+def _mirror_partner(node, ny, nz, mirror_j0):
+    """The node at -y of ``node`` across the mirror plane j = mirror_j0, or -1 (no plane, on it, off the grid)."""
+    if mirror_j0 < 0:
+        return -1
+    j = (node // nz) % ny
+    jm = 2 * mirror_j0 - j
+    if j == mirror_j0 or jm < 0 or jm >= ny:
+        return -1
+    return node + (jm - j) * nz
+
+
 @njit(cache=True, parallel=True)
 def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
     """Sum the chunk copies into nodal mass and velocity and apply the boundary conditions.
@@ -147,19 +159,16 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
             i0 += grid_buf[c, node, 4]
             i1 += grid_buf[c, node, 5]
             i2 += grid_buf[c, node, 6]
-        if mirror_j0 >= 0:
-            j = (node // nz) % ny
-            jm = 2 * mirror_j0 - j
-            if j != mirror_j0 and 0 <= jm < ny:
-                partner = node + (jm - j) * nz
-                for c in range(n_chunks):
-                    m += grid_buf[c, partner, 0]
-                    p0 += grid_buf[c, partner, 1]
-                    p1 -= grid_buf[c, partner, 2]
-                    p2 += grid_buf[c, partner, 3]
-                    i0 += grid_buf[c, partner, 4]
-                    i1 -= grid_buf[c, partner, 5]
-                    i2 += grid_buf[c, partner, 6]
+        partner = _mirror_partner(node, ny, nz, mirror_j0)
+        if partner >= 0:
+            for c in range(n_chunks):
+                m += grid_buf[c, partner, 0]
+                p0 += grid_buf[c, partner, 1]
+                p1 -= grid_buf[c, partner, 2]
+                p2 += grid_buf[c, partner, 3]
+                i0 += grid_buf[c, partner, 4]
+                i1 -= grid_buf[c, partner, 5]
+                i2 += grid_buf[c, partner, 6]
         grid_m[node] = m
         if m > 0.0:
             grid_v[node, 3] = (p0 - i0) / m
@@ -216,14 +225,11 @@ def grid_dilatation(grid_buf, grid_div, shape, mirror_j0):
         for c in range(n_chunks):
             m += grid_buf[c, node, 0]
             t += grid_buf[c, node, 1]
-        if mirror_j0 >= 0:
-            j = (node // nz) % ny
-            jm = 2 * mirror_j0 - j
-            if j != mirror_j0 and 0 <= jm < ny:
-                partner = node + (jm - j) * nz
-                for c in range(n_chunks):
-                    m += grid_buf[c, partner, 0]
-                    t += grid_buf[c, partner, 1]
+        partner = _mirror_partner(node, ny, nz, mirror_j0)
+        if partner >= 0:
+            for c in range(n_chunks):
+                m += grid_buf[c, partner, 0]
+                t += grid_buf[c, partner, 1]
         grid_div[node] = t / m if m > 0.0 else 0.0
 
 
