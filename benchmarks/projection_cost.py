@@ -7,14 +7,16 @@ projection, and the nodal reduction ``grid_dilatation``, on sorted random partic
 block (medians of 41 calls after a warm-up call), and whole G2P steps local and projected
 alternating, whose paired ratio is the number to quote on a noisy machine. The ploughing scenes
 cost more per particle in ``g2p_update`` (plastic return mapping), see
-``benchmarks/kernel_profile.py``.
+``benchmarks/kernel_profile.py``. Writes benchmarks/results/projection_cost.json.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import statistics
 import time
+from pathlib import Path
 
 import numba
 import numpy as np
@@ -96,6 +98,13 @@ def main() -> None:
     print(f"| G2P, alternating pairs | {pair[0]:.2f} | {pair[1]:.2f} |")
     print(f"projected / local, median of {args.repeats} paired ratios: {statistics.median(ratio):.2f} "
           f"(quartiles {np.percentile(ratio, 25):.2f}-{np.percentile(ratio, 75):.2f})")
+    out = Path(__file__).resolve().parent / "results" / "projection_cost.json"
+    out.write_text(json.dumps({
+        "particles": n, "threads": args.threads, "repeats": args.repeats, "ms_per_call": parts,
+        "g2p_pairs_ms": {"local": pair[0], "projected": pair[1]},
+        "ratio_median": statistics.median(ratio),
+        "ratio_quartiles": [float(np.percentile(ratio, 25)), float(np.percentile(ratio, 75))],
+    }, indent=2) + "\n")
 
 if __name__ == "__main__":
     main()

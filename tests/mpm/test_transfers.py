@@ -474,20 +474,25 @@ def projection_reference(grid_v, x, mass):
 
 
 @pytest.mark.parametrize("n_chunks", [1, 3])
-def test_dilatation_projection_matches_reference_and_conserves_volume_change(n_chunks):
-    """The kernels give the slow reference's nodal field, and sum_p m_p d_bar_p = sum_p m_p tr L_p."""
+def test_dilatation_projection_matches_reference_and_conserves_mass_weighted_dilatation(n_chunks):
+    """The kernels give the slow reference's nodal field and the particles' tr L; gathered back
+    from the kernels' nodal field, sum_p m_p d_bar_p = sum_p m_p tr L_p, and the norm shrinks."""
     rng, x, _, _, _, mass = random_particles(n=500, seed=11)
     grid_v = rng.normal(0.0, 0.1, (int(np.prod(SHAPE)), 6))
     buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
     buf[:] = 1.0  # stale content must not leak in
     grid_div = np.full(grid_v.shape[0], np.nan)
     n = x.shape[0]
-    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, np.zeros((n, 3)), np.zeros((n, 3, 3)), np.zeros((n, 3)), mass,
-                      0.0, buf, 1)
+    C = np.zeros((n, 3, 3))
+    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, np.zeros((n, 3)), C, np.zeros((n, 3)), mass, 0.0, buf, 1)
     tr.grid_dilatation(buf, grid_div, SHAPE, -1)
-    tr_p, d_i, d_bar = projection_reference(grid_v, x, mass)
-    scale = np.abs(d_i).max()
-    np.testing.assert_allclose(grid_div, d_i, rtol=0, atol=1e-12 * scale)
+    tr_ref, d_ref, _ = projection_reference(grid_v, x, mass)
+    scale = np.abs(d_ref).max()
+    np.testing.assert_allclose(grid_div, d_ref, rtol=0, atol=1e-12 * scale)
+    tr_p = np.trace(C, axis1=1, axis2=2)  # the kernel's own tr L
+    np.testing.assert_allclose(tr_p, tr_ref, rtol=0, atol=1e-12 * np.abs(tr_ref).max())
+    nodes, w = weights_reference(x)
+    d_bar = (w * grid_div[nodes]).sum(1)  # the kernels' nodal field gathered back
     assert (mass * d_bar).sum() == pytest.approx((mass * tr_p).sum(), rel=1e-10, abs=1e-12 * scale * mass.sum())
     # both steps are weighted means, so (Jensen) the mass-weighted norm can only shrink; a random field shrinks
     assert (mass * d_bar**2).sum() < 0.9 * (mass * tr_p**2).sum()

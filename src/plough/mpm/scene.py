@@ -212,13 +212,14 @@ class Discretisation:
     velocity modes the affine field cannot hold on every transfer, so its numerical dissipation
     grows with the number of steps: on the reference scene at h = 10 um (frictionless), APIC lost
     41% of the sphere's work at CFL 0.075 and the groove depth fell from 2.37 to 1.41 um between
-    CFL 0.3 and 0.075. With flip = 1 mu, mu_sh and dp agree within 1.5% between the two (f = 1).
+    CFL 0.3 and 0.075. With flip = 1 mu, mu_sh and dp agree within 1.5% between the two (f = 1)
+    (measured with the local dilatation).
 
     ``dilatation``: "projected" (default) drives J and the pressure with the dilatation rate
-    projected on the grid (a B-bar / F-bar treatment of volumetric locking, see
+    projected on the grid (an F-bar-like treatment of volumetric locking, see
     :mod:`plough.mpm.transfers`); "local" uses each particle's own. Plastic flow is isochoric, and
     with "local" the block locks: on the coated reference scene at h = 20 / 10 um dp was 1.36 /
-    3.69 um against 4.1 / 12.9 um projected (README, "Volumetric locking").
+    3.69 um against 4.07 / 12.99 um projected (README, "Volumetric locking").
     """
 
     particle_size_m: float = 10e-6

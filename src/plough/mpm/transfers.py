@@ -18,8 +18,11 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
   L_p's). Plastic flow is isochoric: with one dilatation constraint per particle (8 per cell at
   two particles per cell) against three velocity unknowns per node, the discrete velocity field
   cannot deform at constant volume and the block is far too stiff under the sphere (the coated
-  reference scene at h = 20 / 10 um: dp 1.36 / 3.69 um without, 4.1 / 12.9 um with the
-  projection). The projection conserves sum_p m_p d_p exactly.
+  reference scene at h = 20 / 10 um: dp 1.36 / 3.69 um without, 4.07 / 12.99 um with the
+  projection). The projection conserves sum_p m_p d_p exactly. It is F-bar-like, not B-bar: it
+  enters the stress update only, and P2G's internal force still uses each particle's own
+  gradient, so the work dt sum_p V_p p_p (d_bar_p - d_p) of the pressure on the difference is in
+  no energy term (the energy balance of the tests still closes within 3%).
   flip = 0 is APIC. APIC drops the part of the velocity field an affine field cannot hold on
   every transfer: a numerical dissipation per step, so the more steps a slide takes the more of
   the sphere's work it eats (41% at CFL 0.075 on the frictionless reference scene) and the
@@ -29,7 +32,9 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
 Threads: particles are cut into ``n_chunks`` contiguous chunks (in seeding order, so a chunk is a
 slab of the block). The scatter is race-free by construction: chunk c writes only its own grid
 copy ``grid_buf[c]``; the grid update sums the copies node by node (each node owned by one
-iteration). The gather reads the grid and writes only particle p's own entries.
+iteration). The gathers read the grid and write only particle p's own entries; the dilatation
+scatter inside ``g2p_kinematics`` writes only its chunk's ``grid_buf[c]`` and ``g2p_update``
+only its chunk's scratch ``L_buf[c]``.
 """
 
 from __future__ import annotations
@@ -43,7 +48,7 @@ from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update
 from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import APIC_D_INV_FACTOR, bspline2
 
-# per-chunk accumulators written by g2p
+# per-chunk accumulators written by g2p_update
 ACC_PLASTIC_WORK = 0
 ACC_KINETIC = 1
 ACC_ELASTIC = 2
@@ -460,5 +465,5 @@ def allocate_grid_buffers(n_chunks: int, n_nodes: int) -> np.ndarray:
 
 
 def allocate_velocity_gradient_scratch(n_chunks: int) -> np.ndarray:
-    """Per-chunk 3 x 3 scratch for the projected velocity gradient L_bar in ``g2p``."""
+    """Per-chunk 3 x 3 scratch for the projected velocity gradient L_bar in ``g2p_update``."""
     return np.zeros((n_chunks, 3, 3))
