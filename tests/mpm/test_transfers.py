@@ -357,14 +357,34 @@ def test_make_grid_covers_block_with_padding():
         assert math.isclose(g.node_positions()[1, 2] - g.node_positions()[0, 2], dx)
 
 
+MIRROR_DX = 1e-5
+
+
+def half_and_full_grids() -> tuple[Grid, Grid]:
+    """The same block meshed as a half domain (mirror plane y = 0) and as a full domain."""
+    return make_grid(2e-4, 8e-5, True, MIRROR_DX, 3e-5), make_grid(2e-4, 8e-5, False, MIRROR_DX, 3e-5)
+
+
+def particles_near_the_mirror(rng, n: int) -> np.ndarray:
+    return np.column_stack([rng.uniform(3e-5, 1.7e-4, n), rng.uniform(0.0, 5e-5, n), rng.uniform(-6e-5, 0.0, n)])
+
+
+def matching_nodes(half_grid: Grid, full_grid: Grid):
+    """Pairs (i, j): node i of the half-domain grid sits where node j of the full-domain grid does."""
+    index_f = {tuple(np.round(q / MIRROR_DX).astype(int)): j for j, q in enumerate(full_grid.node_positions())}
+    for i, q in enumerate(half_grid.node_positions()):
+        j = index_f.get(tuple(np.round(q / MIRROR_DX).astype(int)))
+        if j is not None:
+            yield i, j
+
+
 def test_mirror_fold_reproduces_the_full_domain():
     """Half domain with the mirror fold == full domain with the mirrored particles, node by node."""
     rng = np.random.default_rng(7)
-    dx = 1e-5
-    half_grid = make_grid(2e-4, 8e-5, True, dx, 3e-5)
-    full_grid = make_grid(2e-4, 8e-5, False, dx, 3e-5)
+    dx = MIRROR_DX
+    half_grid, full_grid = half_and_full_grids()
     n = 400
-    x = np.column_stack([rng.uniform(3e-5, 1.7e-4, n), rng.uniform(0.0, 5e-5, n), rng.uniform(-6e-5, 0.0, n)])
+    x = particles_near_the_mirror(rng, n)
     v = rng.normal(0.0, 0.1, (n, 3))
     C = rng.normal(0.0, 1e3, (n, 3, 3))
     stress = rng.normal(0.0, 1e8, (n, 6))
@@ -387,12 +407,9 @@ def test_mirror_fold_reproduces_the_full_domain():
     gm_h, gv_h, flags_h = grid_v(half_grid, x, v, C, stress, True)
     gm_f, gv_f, _ = grid_v(full_grid, np.vstack([x, x_m]), np.vstack([v, v_m]), np.vstack([C, C_m]),
                            np.vstack([stress, stress_m]), False)
-    pos_h, pos_f = half_grid.node_positions(), full_grid.node_positions()
-    index_f = {tuple(np.round(q / dx).astype(int)): i for i, q in enumerate(pos_f)}
     checked = 0
-    for i, q in enumerate(pos_h):
-        j = index_f.get(tuple(np.round(q / dx).astype(int)))
-        if j is None or gm_f[j] == 0.0:
+    for i, j in matching_nodes(half_grid, full_grid):
+        if gm_f[j] == 0.0:
             continue
         checked += 1
         if flags_h[i] == MIRROR:  # the plane keeps the half body's mass; v_y = 0 there
@@ -542,11 +559,10 @@ def test_uniform_dilatation_passes_the_projection_unchanged():
 def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain():
     """Half domain (mirror fold) and full domain with mirrored particles give the same nodal field."""
     rng = np.random.default_rng(8)
-    dx = 1e-5
-    half_grid = make_grid(2e-4, 8e-5, True, dx, 3e-5)
-    full_grid = make_grid(2e-4, 8e-5, False, dx, 3e-5)
+    dx = MIRROR_DX
+    half_grid, full_grid = half_and_full_grids()
     n = 300
-    x = np.column_stack([rng.uniform(3e-5, 1.7e-4, n), rng.uniform(0.0, 5e-5, n), rng.uniform(-6e-5, 0.0, n)])
+    x = particles_near_the_mirror(rng, n)
     mass = RHO * (0.5 * dx) ** 3 * rng.uniform(0.8, 1.2, n)
 
     def velocity(pos):  # a smooth field even in y for v_x, v_z and odd for v_y
@@ -566,11 +582,9 @@ def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain(
 
     d_h = project(half_grid, x, mass, True)
     d_f = project(full_grid, np.vstack([x, x * [1.0, -1.0, 1.0]]), np.concatenate([mass, mass]), False)
-    index_f = {tuple(np.round(q / dx).astype(int)): i for i, q in enumerate(full_grid.node_positions())}
     checked = 0
-    for i, q in enumerate(half_grid.node_positions()):
-        j = index_f.get(tuple(np.round(q / dx).astype(int)))
-        if j is None or d_f[j] == 0.0:
+    for i, j in matching_nodes(half_grid, full_grid):
+        if d_f[j] == 0.0:
             continue
         checked += 1
         assert d_h[i] == pytest.approx(d_f[j], rel=1e-9, abs=1e-9 * np.abs(d_f).max())
