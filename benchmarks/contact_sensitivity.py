@@ -15,8 +15,10 @@ benchmarks/results/contact_sensitivity.json (a case is run only when missing or 
 3. Contact-pressure probe at the defaults: over the last 0.1 mm of a 0.4 mm slide, the normal stress
    -n.sigma.n that the contact uses at each contact node (mass-weighted over the node's particles),
    against the hardness, and the share of the normal force on nodes whose shear area is capped at
-   a cell face (``contact.contact_area``); and the normal stress of the particles whose face lies
-   within a fraction of h of the sphere.
+   a cell face (``contact.contact_area``). P is reported before the solver's floor at kappa, from
+   the particles' stress after the step (the contact used the stress before it: one step apart).
+   Also the normal stress of the particles whose face lies within a fraction of h of the sphere
+   ahead of its centre, in one snapshot at the end of the slide.
 """
 
 from __future__ import annotations
