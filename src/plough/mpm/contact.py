@@ -12,29 +12,35 @@ whole load, and the contact switching on and off with it).
 
 The tangential velocity change is a traction-limited impulse:
 
-    J_t <= tau * A_i * dt,     A_i = min(<F_n,i> / P_i, dx^2)
+    J_t <= tau * A_i * dt,     A_i = | sum_p V_p grad N_i(x_p) |
 
-with P_i = -n . sigma_i . n the local contact pressure from the mass-averaged stress of the
-particles near node i, <F_n,i> the node's normal contact force filtered over a physical
-time (FILTER_WAVE_TIMES elastic-wave transits of a cell, dx / c), and the interface shear strength
+with A_i the node's share of the material's surface: by the divergence theorem
+sum_p V_p grad N_i(x_p) ~ integral over the body of grad N_i = integral over its boundary of N_i n dA,
+so the shares of the nodes near a face add up to the face's area however many layers of nodes
+touch it (for a lattice-aligned flat face exactly: the particles' midpoint rule integrates the
+piecewise-linear B-spline derivative exactly). The interface shear strength is
 
     proportional:    tau = f * kappa                 (kappa = sigma_y / sqrt(3) of the material)
     constant:        tau = H0 / k0
-    boundary layer:  tau = Cp * P^np                 (P in Pa, Table 5)
+    boundary layer:  tau = Cp * P^np                 (P in Pa, Table 5; P = -n . sigma . n of the
+                                                      node's particles, mass-averaged)
 
 always capped at kappa (never above the contacting material's shear strength) and never larger
 than the impulse that stops the slip (so the slip never reverses). The reaction on the sphere
 is minus the impulses, split into the normal-traction (ploughing) and interface-shear parts.
 
-Why the filter: the explicit normal projection acts on a node only on the steps it approaches
-the sphere, and the contact rings at the elastic-wave period (on the reference scene no node
-approaches on 16% of the steps at CFL 0.3, 27% at CFL 0.15). An area taken from one step's
-impulse then switches between 0 and the face cap, and the mean shear force followed the time
-step (mu_sh 0.189 at CFL 0.3, 0.134 at CFL 0.15, with the APIC transfer of the time). The real
-contact does not open and close at that period, so a node in persistent contact (pushed on the
-previous step, or held since with a filtered area of at least RELEASE_AREA of a cell face)
-carries interface shear on every step, over the area of its filtered normal force; a held node
-that separates keeps its normal velocity.
+Why a hold: the explicit normal projection acts on a node only on the steps it approaches the
+sphere, and the contact rings at the elastic-wave period (on the reference scene no node
+approaches on 16% of the steps at CFL 0.3). A node pushed within the last HOLD_WAVE_TIMES
+elastic-wave transits of a cell (dx / c, the ringing period's scale) stays in contact and carries
+interface shear on the steps it is not pushed; a held node keeps its normal velocity.
+
+Why not the earlier area min(F_n,i / P_i, dx^2) with a filtered F_n,i: P_i from the particles'
+stress was 0.40 of the hardness at h = 10 um (the particles next to the sphere carry little of the
+contact pressure, the grid does), so 82% of the normal force sat on nodes whose area was capped at
+a face, and a node kept shear until its filtered force had faded, about 0.7 cell of sliding: mu_sh
+followed the filter time (+0.004 per wave transit) and grew without settling as the mass scaling
+fell (README, "Interface shear"; benchmarks/contact_sensitivity.py).
 """
 
 from __future__ import annotations
@@ -45,14 +51,14 @@ from numba import njit
 
 from plough.mpm.constitutive import mixed_flow_stress
 from plough.mpm.grid import GHOST, MIRROR
-from plough.mpm.shape import bspline2
+from plough.mpm.shape import bspline2, bspline2_grad
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
 SQRT3 = math.sqrt(3.0)
-#: time constant of the per-node normal-force filter, in elastic-wave transits of a cell (dx / c)
-FILTER_WAVE_TIMES = 10.0
-#: a held node that is not pushed leaves the contact once its filtered area falls below this fraction of a face
-RELEASE_AREA = 0.01
+#: a node stays in contact this many elastic-wave transits of a cell (dx / c) after its last normal push
+HOLD_WAVE_TIMES = 2.0
+#: last_push of a node never pushed (far enough back that step - it stays within int64)
+NEVER_PUSHED = -(2**62)
 
 # outputs of sphere_contact
 OUT_FN = 0  # 0:3 force on the sphere from normal impulses, N
@@ -63,8 +69,10 @@ OUT_WORK = 8  # work done by the sphere on the material this step, J
 OUT_NODES = 9  # number of contact nodes
 OUT_AREA_XY = 10  # contact area projected on the xy plane, m^2
 N_OUT = 11
-#: channels of the contact scratch: 6 stress, kappa, mass weight, proximity dx - gap of the closest particle
-N_CBUF = 9
+#: channels of the contact scratch: 6 stress, kappa, mass weight, proximity dx - gap of the closest particle,
+#: 3 the surface vector sum_p V_p grad N_i (C_AREA: C_AREA + 3)
+C_AREA = 9
+N_CBUF = 12
 
 
 @njit(cache=True)
@@ -78,17 +86,26 @@ def _inside_box(origin, dx, shape, centre, radius):
     return lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
 
 
+@njit(cache=True, inline="always")
+def _pick(k, v0, v1, v2):
+    return v0 if k == 0 else (v1 if k == 1 else v2)
+
+
 @njit(cache=True)
 def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near, origin,
-                           dx, shape, centre, radius, cbuf):
-    """Mass-weighted stress and shear strength of the particles near the sphere onto nearby nodes.
+                           dx, shape, centre, radius, mirror_j0, cbuf):
+    """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
+    sphere onto nearby nodes.
 
     Reads particle x, stress, mass, vol0, J, eps_p, temperature, materials and ``near`` (set by
     g2p). For nodes within one cell of the sphere surface (or inside it) writes
-    cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m and
-    cbuf[node, 8] = max(cbuf[node, 8], dx - gap) over its particles, gap = distance from the
-    particle's face (half a particle size from its centre) to the sphere surface. Serial: few particles are near
-    the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
+    cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m,
+    cbuf[node, 8] = max(cbuf[node, 8], dx - gap) over its particles (gap = distance from the
+    particle's face, half a particle size from its centre, to the sphere surface) and
+    cbuf[node, C_AREA:C_AREA + 3] += V grad w (the node's share of the material's surface, as a
+    vector). With the mirror plane (``mirror_j0`` >= 0, else -1) the surface vector of a ghost node
+    (y < 0) goes to its partner with its y component reversed: the mirrored particles' share.
+    Serial: few particles are near the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
     """
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
@@ -99,8 +116,9 @@ def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, 
         q0 = x[p, 0] - centre[0]
         q1 = x[p, 1] - centre[1]
         q2 = x[p, 2] - centre[2]
+        vol = vol0[p] * J[p]
         # proximity dx - gap of the particle's face to the sphere surface (> 0 within one cell)
-        prox = dx - (math.sqrt(q0 * q0 + q1 * q1 + q2 * q2) - radius - 0.5 * (vol0[p] * J[p]) ** (1.0 / 3.0))
+        prox = dx - (math.sqrt(q0 * q0 + q1 * q1 + q2 * q2) - radius - 0.5 * vol ** (1.0 / 3.0))
         kappa = mixed_flow_stress(table[mat_a[p]], table[mat_b[p]], frac_a[p], eps_p[p], 0.0,
                                   temperature[p]) / SQRT3
         gx = (x[p, 0] - origin[0]) * inv_dx
@@ -109,17 +127,25 @@ def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, 
         bx, wx0, wx1, wx2 = bspline2(gx)
         by, wy0, wy1, wy2 = bspline2(gy)
         bz, wz0, wz1, wz2 = bspline2(gz)
+        _, dwx0, dwx1, dwx2 = bspline2_grad(gx)
+        _, dwy0, dwy1, dwy2 = bspline2_grad(gy)
+        _, dwz0, dwz1, dwz2 = bspline2_grad(gz)
+        v_dx = vol * inv_dx  # V grad w, with the derivatives in grid units
         for a in range(3):
-            wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
+            wa = _pick(a, wx0, wx1, wx2)
+            da = _pick(a, dwx0, dwx1, dwx2)
             px = origin[0] + (bx + a) * dx - centre[0]
             for b in range(3):
-                wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
+                wb = _pick(b, wy0, wy1, wy2)
+                db = _pick(b, dwy0, dwy1, dwy2)
                 py = origin[1] + (by + b) * dx - centre[1]
                 for cc in range(3):
                     pz = origin[2] + (bz + cc) * dx - centre[2]
                     if px * px + py * py + pz * pz >= reach2:
                         continue
-                    wm = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2)) * mass[p]
+                    wc = _pick(cc, wz0, wz1, wz2)
+                    dc = _pick(cc, dwz0, dwz1, dwz2)
+                    wm = wa * wb * wc * mass[p]
                     node = ((bx + a) * ny + (by + b)) * nz + bz + cc
                     for k in range(6):
                         cbuf[node, k] += wm * stress[p, k]
@@ -127,6 +153,15 @@ def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, 
                     cbuf[node, 7] += wm
                     if prox > cbuf[node, 8]:
                         cbuf[node, 8] = prox
+                    s1 = v_dx * wa * db * wc
+                    j = by + b
+                    if mirror_j0 >= 0 and j < mirror_j0:
+                        j = 2 * mirror_j0 - j
+                        s1 = -s1
+                    target = ((bx + a) * ny + j) * nz + bz + cc
+                    cbuf[target, C_AREA] += v_dx * da * wb * wc
+                    cbuf[target, C_AREA + 1] += s1
+                    cbuf[target, C_AREA + 2] += v_dx * wa * wb * dc
 
 
 @njit(cache=True)
@@ -142,37 +177,34 @@ def interface_shear(model, iparams, pressure, kappa):
 
 
 @njit(cache=True)
-def contact_area(fn, pressure, kappa, dx2):
-    """Area a node's normal force fn (N) acts on, A_i = min(F_n,i / P_i, dx^2).
+def surface_share(cbuf, node, mirror_plane):
+    """The node's share of the material's surface, |sum_p V_p grad N_i|, m^2.
 
-    The contact pressure is floored at the shear strength kappa, which bounds the local ratio
-    tau / P by tau / kappa <= 1 where the particles' stress gives little pressure (contact edge,
-    tensile stress); a node covers at most one cell face. A node without material strength
-    (kappa = 0) and no pressure counts one cell face.
+    On the mirror plane the half body owns half of the node: the mirrored particles cancel the y
+    component and double the others, so its share is the x-z part of its own particles' vector.
     """
-    p = max(pressure, kappa)
-    if p <= 0.0:
-        return dx2
-    return min(fn / p, dx2)
+    g0 = cbuf[node, C_AREA]
+    g1 = 0.0 if mirror_plane else cbuf[node, C_AREA + 1]
+    g2 = cbuf[node, C_AREA + 2]
+    return math.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
 
 
 @njit(cache=True)
-def sphere_contact(grid_m, grid_v, cbuf, flags, fn_filtered, last_step, step, alpha, origin, dx, shape, centre,
-                   radius, v_sphere, dt, model, iparams, out):
+def sphere_contact(grid_m, grid_v, cbuf, flags, last_push, step, hold_steps, origin, dx, shape, centre, radius,
+                   v_sphere, dt, model, iparams, out):
     """Impose the sphere on the nodes inside it and measure the reaction.
 
     Reads grid_m, cbuf (from scatter_contact_stress; its entries are zeroed here). Reads and
-    writes the per-node contact memory fn_filtered (filtered normal force, N) and last_step (the
-    step a node was last in contact; a value older than step - 1 counts as no contact): the
-    filter is fn += alpha (F_n - fn) with alpha = dt / filter time. Writes grid_v of contact
-    nodes and out[0:N_OUT] (see the OUT_* indices).
+    writes the per-node contact memory last_push (the step a node's velocity was last cut by the
+    normal projection): a node pushed now, or within the last ``hold_steps`` steps, is in contact
+    and carries interface shear. Writes grid_v of contact nodes and out[0:N_OUT] (see the OUT_*
+    indices).
     """
     ny, nz = shape[1], shape[2]
     for k in range(N_OUT):
         out[k] = 0.0
     i0, i1, j0, j1, k0, k1 = _inside_box(origin, dx, shape, centre, radius + dx)
     r2 = (radius + dx) * (radius + dx)
-    dx2 = dx * dx
     for i in range(i0, i1 + 1):
         px = origin[0] + i * dx - centre[0]
         for j in range(j0, j1 + 1):
@@ -192,13 +224,14 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, fn_filtered, last_step, step, al
                 s5 = cbuf[node, 5]
                 kap = cbuf[node, 6]
                 prox = cbuf[node, 8]
+                area = surface_share(cbuf, node, flags[node] == MIRROR)
                 for k in range(N_CBUF):
                     cbuf[node, k] = 0.0
                 m = grid_m[node]
                 dist = math.sqrt(d2)
                 if m <= 0.0 or prox <= 0.0 or flags[node] == GHOST or dist <= 0.0:
                     continue  # ghosts (y < 0) mirror their partners: their impulse is not the body's
-                held = last_step[node] == step - 1  # in contact on the previous step
+                held = step - last_push[node] <= hold_steps
                 gap = max(dx - prox, 0.0)  # of the node's closest particle face
                 n0 = px / dist
                 n1 = py / dist
@@ -212,8 +245,10 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, fn_filtered, last_step, step, al
                 vn = r0 * n0 + r1 * n1 + r2v * n2
                 vn_min = -gap / dt  # the closest particle may still approach by its gap in this step
                 jn = m * (vn_min - vn) if vn < vn_min else 0.0
-                fn_old = fn_filtered[node] if held else 0.0
-                fn_new = fn_old + alpha * (jn / dt - fn_old)
+                if jn <= 0.0 and not held:
+                    continue  # neither pushed now nor within the hold
+                if jn > 0.0:
+                    last_push[node] = step
                 t0 = r0 - vn * n0
                 t1 = r1 - vn * n1
                 t2 = r2v - vn * n2
@@ -226,13 +261,6 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, fn_filtered, last_step, step, al
                 else:
                     pressure = 0.0
                     kappa = 0.0
-                # a node on the mirror plane carries the half body's share: half its cell face
-                face = 0.5 * dx2 if flags[node] == MIRROR else dx2
-                area = contact_area(fn_new, pressure, kappa, face)
-                if jn <= 0.0 and (not held or area < RELEASE_AREA * face):
-                    continue  # not pressed now, and not held or its filtered force has faded
-                fn_filtered[node] = fn_new
-                last_step[node] = step
                 vn_after = max(vn, vn_min)
                 tau = interface_shear(model, iparams, pressure, kappa)
                 jt = 0.0

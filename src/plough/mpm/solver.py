@@ -83,7 +83,7 @@ class Constants:
     slide_speed: float
     slide_distance: float
     control_gain: float  # m/s per N
-    contact_alpha: float  # weight of one step in the per-node contact-force filter
+    contact_hold_steps: float  # a node stays in contact this many steps after its last normal push
     flip: float  # FLIP share of the particle velocity update (0 = APIC)
     project_dilatation: int  # 1: J and pressure from the grid-projected dilatation rate
     filter_alpha: float
@@ -104,8 +104,7 @@ class Work:
     grid_v: np.ndarray  # (nodes, 6): velocity, and velocity before the internal force (FLIP)
     flags: np.ndarray
     cbuf: np.ndarray
-    fn_filtered: np.ndarray  # per-node filtered contact normal force, N
-    last_contact: np.ndarray  # per-node step of the last contact
+    last_push: np.ndarray  # per-node step of the last normal push of the contact
     acc: np.ndarray
     contact_out: np.ndarray
     grid_div: np.ndarray  # projected nodal dilatation rate, 1/s
@@ -176,7 +175,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
         flip=disc.flip, project_dilatation=int(disc.dilatation == "projected"),
-        contact_alpha=min(dt / (contact.FILTER_WAVE_TIMES * dx / c), 1.0),
+        contact_hold_steps=contact.HOLD_WAVE_TIMES * dx / (c * dt),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
         shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
@@ -185,8 +184,8 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
         grid_v=np.zeros((grid.n_nodes, 6)),
         flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
-        cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), fn_filtered=np.zeros(grid.n_nodes),
-        last_contact=np.full(grid.n_nodes, -2, dtype=np.int64), acc=np.zeros((n_chunks, transfers.N_ACC)),
+        cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), last_push=np.full(grid.n_nodes, contact.NEVER_PUSHED),
+        acc=np.zeros((n_chunks, transfers.N_ACC)),
         contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
         L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
     )
@@ -215,9 +214,9 @@ def step(s: State, c: Constants) -> None:
     transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v, c.shape, c.mirror_j0)
     contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
                                    p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
-                                   w.cbuf)
-    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, w.fn_filtered, w.last_contact, s.step, c.contact_alpha,
-                           g.origin, g.dx, c.shape, sph.centre, c.sphere_radius, sph.velocity, c.dt, c.interface_model,
+                                   c.mirror_j0, w.cbuf)
+    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, w.last_push, s.step, c.contact_hold_steps, g.origin,
+                           g.dx, c.shape, sph.centre, c.sphere_radius, sph.velocity, c.dt, c.interface_model,
                            c.interface_params, w.contact_out)
     if c.mirror_j0 >= 0:
         transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0)
