@@ -5,10 +5,12 @@ A hand-made grid with random nodal masses, velocities and contact stresses is gi
 impenetrability of approaching contact nodes (within one cell of the sphere surface or inside it,
 carrying a touching particle), untouched separating, non-touching and outside nodes, reaction =
 minus the impulses, the traction-limited tangential impulse that never reverses the slip, the
-energy account, and the consumption of the contact stress buffer. Single calls without contact
-memory (filter weight 1) reduce the filtered area to the step's own normal force; separate tests
-cover the gap-limited approach of nodes whose closest particle has not reached the sphere yet and
-the persistent contact (memory, release).
+energy account, and the consumption of the contact stress buffer. Single calls start without
+contact memory (no node pushed before); separate tests cover the gap-limited approach of nodes
+whose closest particle has not reached the sphere yet and the hold (a node pushed within the last
+``hold_steps`` steps stays in contact). The surface vector sum_p V_p grad N_i that gives the
+shear area is checked against an independent accumulation and, for a flat lattice block, against
+the block's top-face area to round-off.
 """
 
 from __future__ import annotations
@@ -22,7 +24,7 @@ from plough.materials import rigid_plastic
 from plough.mpm import contact as ct
 from plough.mpm.constitutive import pack_materials
 from plough.mpm.grid import Grid
-from plough.mpm.shape import bspline2
+from plough.mpm.shape import bspline2, bspline2_grad
 
 DX = 1e-5
 SHAPE = np.array([12, 11, 13], dtype=np.int64)
@@ -64,14 +66,19 @@ def make_case(seed, centre=None, radius=3.3 * DX):
     cbuf[:, 6] = w * kappa
     cbuf[:, 7] = w
     cbuf[:, 8] = DX * (rng.random(N_NODES) < 0.85)  # proximity DX - gap: a particle of the node touches
+    # surface vector sum V grad N: shares of up to a cell face
+    cbuf[:, ct.C_AREA:ct.C_AREA + 3] = rng.normal(size=(N_NODES, 3)) * (DX * DX * rng.uniform(0, 0.6, N_NODES))[:, None]
     cbuf[rng.random(N_NODES) < 0.05, :] = 0.0  # nodes no particle reached
     return dict(grid_m=grid_m, grid_v=grid_v, cbuf=cbuf, centre=np.asarray(centre, float), radius=radius,
                 v_sphere=v_sphere)
 
 
+HOLD = 6.0  # steps a node stays in contact after its last push
+
+
 def no_memory():
-    """Contact memory of a first step: no node held, the filter takes the step's force as it is."""
-    return np.zeros(N_NODES), np.full(N_NODES, -2, dtype=np.int64), 0, 1.0
+    """Contact memory of a first step: no node pushed before (last_push, step, hold_steps)."""
+    return np.full(N_NODES, ct.NEVER_PUSHED), 0, HOLD
 
 
 def call(case, model, iparams):
@@ -193,9 +200,7 @@ def test_tangential_impulse_is_traction_limited_and_never_reverses(model, iparam
             pressure = kappa = 0.0
         tau = expected_tau(model, iparams, pressure, kappa)
         assert tau <= kappa * (1 + 1e-15)
-        jn = -m[i] * vn[i]
-        p_floor = max(pressure, kappa)  # the contact pressure is floored at the shear strength
-        area = DX * DX if p_floor <= 0 else min(jn / (DT * p_floor), DX * DX)
+        area = np.linalg.norm(cb[i, ct.C_AREA:ct.C_AREA + 3])  # the node's share of the surface
         if n[i][2] < 0:
             area_xy += area * -n[i][2]
         limit = tau * area * DT
@@ -290,7 +295,7 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     near = (rng.random(n) < 0.7).astype(np.int8)
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
     ct.scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near,
-                              ORIGIN, DX, SHAPE, centre, radius, cbuf)
+                              ORIGIN, DX, SHAPE, centre, radius, -1, cbuf)
     # independent accumulation
     sy = np.array([450e6 / 3, 900e6 / 3])
     kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
@@ -303,6 +308,7 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     for p in np.flatnonzero(near):
         g = (x[p] - ORIGIN) / DX
         stencil = [bspline2(gd) for gd in g]
+        slopes = [bspline2_grad(gd) for gd in g]  # per grid unit
         for a in range(3):
             for b in range(3):
                 for c in range(3):
@@ -315,6 +321,11 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
                     expected[node, 6] += w * kappa[p]
                     expected[node, 7] += w
                     expected[node, 8] = max(expected[node, 8], DX - gap[p])
+                    wx, wy, wz = stencil[0][1 + a], stencil[1][1 + b], stencil[2][1 + c]
+                    dwx, dwy, dwz = slopes[0][1 + a], slopes[1][1 + b], slopes[2][1 + c]
+                    v = vol0[p] * J[p] / DX
+                    grad = np.array([dwx * wy * wz, wx * dwy * wz, wx * wy * dwz])
+                    expected[node, ct.C_AREA:ct.C_AREA + 3] += v * grad
     np.testing.assert_array_equal(cbuf[~reach], 0.0)
     assert (cbuf[reach, 7] > 0).sum() > 10
     assert 0 < (cbuf[reach, 8] >= DX).sum() < (cbuf[reach, 8] > 0).sum() <= (cbuf[reach, 7] > 0).sum()
@@ -322,8 +333,9 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
 
 
 # ----------------------------------------------------------------------------- gap and contact memory
-def one_node_case(rel_velocity_n, rel_velocity_t, prox, kappa=1.0e8, pressure=3.0e8):
-    """A single massive node just under the sphere; relative velocity given along n and one tangent."""
+def one_node_case(rel_velocity_n, rel_velocity_t, prox, kappa=1.0e8, pressure=3.0e8, area=0.5 * DX * DX):
+    """A single massive node just under the sphere; relative velocity given along n and one tangent;
+    its surface vector points up (out of the material, towards the sphere) with |g| = area."""
     centre = ORIGIN + DX * np.array([5.0, 5.0, 9.0])
     radius = 3.0 * DX
     node = (5 * SHAPE[1] + 5) * SHAPE[2] + 6  # straight below the centre, on the sphere surface
@@ -339,16 +351,16 @@ def one_node_case(rel_velocity_n, rel_velocity_t, prox, kappa=1.0e8, pressure=3.
     cbuf[node, 6] = kappa
     cbuf[node, 7] = 1.0
     cbuf[node, 8] = prox
+    cbuf[node, ct.C_AREA + 2] = area  # the material below: outward normal up, towards the sphere
     return dict(node=node, centre=centre, radius=radius, n=n, t=t, v_sphere=v_sphere, grid_m=grid_m, grid_v=grid_v,
                 cbuf=cbuf)
 
 
-def call_with_memory(c, fn_filtered, last_step, step, alpha, f=1.0):
+def call_with_memory(c, last_push, step, hold_steps, f=1.0):
     grid_v = c["grid_v"].copy()
     out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(c["grid_m"], grid_v, c["cbuf"].copy(), NO_FLAGS, fn_filtered, last_step, step, alpha, ORIGIN,
-                      DX, SHAPE, c["centre"], c["radius"], c["v_sphere"], DT, ct.INTERFACE_PROPORTIONAL,
-                      np.array([f, 0.0]), out)
+    ct.sphere_contact(c["grid_m"], grid_v, c["cbuf"].copy(), NO_FLAGS, last_push, step, hold_steps, ORIGIN, DX, SHAPE,
+                      c["centre"], c["radius"], c["v_sphere"], DT, ct.INTERFACE_PROPORTIONAL, np.array([f, 0.0]), out)
     rel = grid_v[c["node"]] - c["v_sphere"]
     return rel @ c["n"], rel @ c["t"], out
 
@@ -371,54 +383,102 @@ def test_node_may_approach_by_its_closest_particles_gap():
     assert vn == pytest.approx(-10.0 * DX / DT) and out[ct.OUT_NODES] == 0
 
 
-def test_held_node_keeps_interface_shear_while_separating_and_is_released_when_its_force_fades():
-    kappa, pressure, alpha, step = 1.0e8, 3.0e8, 0.1, 7
+def test_held_node_keeps_interface_shear_while_separating_until_the_hold_ends():
+    kappa, step, hold = 1.0e8, 40, 6.0
     slip = 100.0  # m/s: far more than the traction can stop in one step (DT is large)
-    c = one_node_case(+1e-3, slip, prox=DX)  # separating this step
+    area = 0.37 * DX * DX
+    c = one_node_case(+1e-3, slip, prox=DX, kappa=kappa, area=area)  # separating this step
     node = c["node"]
     m = c["grid_m"][node]
-    f0 = 0.5 * pressure * DX * DX  # filtered force of half a face at the contact pressure
-    fn = np.zeros(N_NODES)
-    last = np.full(N_NODES, -2, dtype=np.int64)
-    fn[node], last[node] = f0, step - 1
-    vn, vt, out = call_with_memory(c, fn, last, step, alpha)
-    f1 = (1.0 - alpha) * f0  # no normal impulse this step: the filter decays
-    area = f1 / pressure
-    assert vn == pytest.approx(1e-3, rel=1e-9)  # the normal velocity is left alone
-    assert m * (slip - vt) == pytest.approx(kappa * area * DT, rel=1e-9)  # tau = f kappa over the filtered area
-    assert fn[node] == pytest.approx(f1, rel=1e-12) and last[node] == step
-    assert out[ct.OUT_NODES] == 1 and np.all(out[ct.OUT_FN:ct.OUT_FN + 3] == 0.0)
-    # the same node not held on the previous step: separating, so no contact at all
-    fn[node], last[node] = f0, step - 2
-    vn, vt, out = call_with_memory(c, fn, last, step, alpha)
-    assert vt == pytest.approx(slip, rel=1e-12) and out[ct.OUT_NODES] == 0 and last[node] == step - 2
-    # held but with a faded force (area below RELEASE_AREA of a face): released, untouched
-    fn[node], last[node] = 0.5 * ct.RELEASE_AREA * pressure * DX * DX, step - 1
-    vn, vt, out = call_with_memory(c, fn, last, step, alpha)
-    assert vt == pytest.approx(slip, rel=1e-12) and out[ct.OUT_NODES] == 0 and last[node] == step - 1
+    last = np.full(N_NODES, ct.NEVER_PUSHED)
+    for since in (1, 3, 6):  # pushed this many steps ago: within the hold
+        last[node] = step - since
+        vn, vt, out = call_with_memory(c, last, step, hold)
+        assert vn == pytest.approx(1e-3, rel=1e-9)  # the normal velocity is left alone
+        assert m * (slip - vt) == pytest.approx(kappa * area * DT, rel=1e-9)  # tau = f kappa over the surface share
+        assert last[node] == step - since  # not pushed now: the memory keeps the last push
+        assert out[ct.OUT_NODES] == 1 and np.all(out[ct.OUT_FN:ct.OUT_FN + 3] == 0.0)
+        assert out[ct.OUT_FT + 0] == pytest.approx(kappa * area, rel=1e-9)  # the shear force on the sphere
+    # pushed longer ago than the hold: released, untouched
+    last[node] = step - 7
+    vn, vt, out = call_with_memory(c, last, step, hold)
+    assert vt == pytest.approx(slip, rel=1e-12) and out[ct.OUT_NODES] == 0 and last[node] == step - 7
+    # never pushed: a separating node is not in contact
+    last[node] = ct.NEVER_PUSHED
+    vn, vt, out = call_with_memory(c, last, step, hold)
+    assert vt == pytest.approx(slip, rel=1e-12) and out[ct.OUT_NODES] == 0
+    # pushed now: in contact and remembered
+    c = one_node_case(-1e-3, slip, prox=DX, kappa=kappa, area=area)
+    vn, vt, out = call_with_memory(c, last, step, hold)
+    assert last[node] == step and out[ct.OUT_NODES] == 1 and vn == pytest.approx(0.0, abs=1e-12)
 
 
-def test_filtered_force_follows_a_steady_push_and_smooths_a_bursty_one():
-    """Pushed every step by F the filter tends to F; pushed every other step by 2F it tends to ~F too."""
-    alpha = 0.05
-    weak = dict(kappa=1.0e3, pressure=2.0e3)  # the push spreads over half a face: held, not released
-    c = one_node_case(-1e-4, 0.0, prox=DX, **weak)
-    node = c["node"]
-    m = c["grid_m"][node]
-    push = m * 1e-4 / DT
-    fn = np.zeros(N_NODES)
-    last = np.full(N_NODES, -2, dtype=np.int64)
-    for step in range(400):
-        call_with_memory(c, fn, last, step, alpha)
-    assert fn[node] == pytest.approx(push, rel=1e-6)
-    bursty = one_node_case(-2e-4, 0.0, prox=DX, **weak)
-    resting = one_node_case(+1e-9, 0.0, prox=DX, **weak)
-    fn[:] = 0.0
-    last[:] = -2
-    history = []
-    for step in range(400):
-        call_with_memory(bursty if step % 2 == 0 else resting, fn, last, step, alpha)
-        history.append(fn[node])
-    assert last[node] == 399  # held throughout, also on the steps without a push
-    assert np.mean(history[-40:]) == pytest.approx(push, rel=0.05)
-    assert np.ptp(history[-40:]) < 0.25 * push
+def test_a_ringing_node_carries_the_same_shear_on_every_step():
+    """Pushed every third step (the contact rings), the node's interface shear does not switch off in
+    between: the shear area is the surface share, not the step's normal impulse."""
+    slip, area, kappa = 100.0, 0.5 * DX * DX, 1.0e8
+    pushed = one_node_case(-2e-4, slip, prox=DX, kappa=kappa, area=area)
+    resting = one_node_case(+1e-9, slip, prox=DX, kappa=kappa, area=area)
+    node = pushed["node"]
+    last = np.full(N_NODES, ct.NEVER_PUSHED)
+    shear = []
+    for step in range(30):
+        _, _, out = call_with_memory(pushed if step % 3 == 0 else resting, last, step, HOLD)
+        shear.append(out[ct.OUT_FT + 0])
+        assert last[node] == step - step % 3
+    np.testing.assert_allclose(shear, kappa * area, rtol=1e-9)
+
+
+# ----------------------------------------------------------------------------- the surface vector
+def _lattice(lo, hi, h):
+    """Particle centres of a block [lo, hi] (grid units of DX) filled with cubes of edge h (grid units)."""
+    axes = [np.arange(lo[d] + 0.5 * h, hi[d], h) for d in range(3)]
+    g = np.stack(np.meshgrid(*axes, indexing="ij"), axis=-1).reshape(-1, 3)
+    return ORIGIN + g * DX
+
+
+def _scatter_surface(x, h, mirror_j0=-1):
+    n = x.shape[0]
+    table = pack_materials([rigid_plastic("sub", 900e6, coating=False)])
+    zeros = np.zeros(n)
+    ones = np.ones(n)
+    cbuf = np.zeros((N_NODES, ct.N_CBUF))
+    centre = ORIGIN + DX * (SHAPE - 1) / 2
+    # a sphere so large that every node is within its reach: the whole surface vector field is written
+    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, zeros, np.full(n, 298.0),
+                              np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones, table,
+                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, 1.0, mirror_j0, cbuf)
+    return cbuf[:, ct.C_AREA:ct.C_AREA + 3].reshape(*SHAPE, 3)
+
+
+@pytest.mark.parametrize("h", [0.5, 1.0 / 3.0])
+def test_surface_vector_gives_the_top_face_area_of_a_flat_block_exactly(h):
+    """Block [2, 9] x [2, 9] x [2, 10] cells. The nodes k >= 7 see the top face only: the sum of the
+    z components there is the face's area (7 x 7 cells) to round-off: the particles' midpoint rule
+    integrates the B-spline derivatives exactly on these node-symmetric lattices (2 and 3 particles
+    per cell); the whole field sums to zero (partition of unity)."""
+    g = _scatter_surface(_lattice([2, 2, 2], [9, 9, 10], h), h)
+    area = 49.0 * DX * DX
+    assert g[:, :, 7:, 2].sum() == pytest.approx(area, rel=1e-12)
+    np.testing.assert_allclose(g[:, :, 7:, :2].sum(axis=(0, 1, 2)), 0.0, atol=1e-12 * area)
+    np.testing.assert_allclose(g.sum(axis=(0, 1, 2)), 0.0, atol=1e-12 * area)
+    # inside the block, away from every face, the shares vanish
+    np.testing.assert_allclose(g[4:8, 4:8, 4:6], 0.0, atol=1e-12 * area)
+    # and the top face's nodes point up: out of the material
+    assert np.all(g[4:8, 4:8, 9:, 2] >= -1e-12 * area)
+
+
+def test_surface_vector_mirror_fold_equals_the_full_block():
+    """A block symmetric about the node plane y = 0 (j = 5) against its half y > 0 with the fold: on the
+    nodes j > 5 the half gives the full block's vectors; on the plane its own particles give half of
+    the full block's x and z components (the half body's share)."""
+    j0 = 5
+    assert ORIGIN[1] + j0 * DX == pytest.approx(0.0, abs=1e-20)
+    h = 0.5
+    full = _scatter_surface(_lattice([2, 2, 2], [9, 8, 10], h), h)
+    half = _scatter_surface(_lattice([2, 5, 2], [9, 8, 10], h), h, mirror_j0=j0)
+    scale = DX * DX
+    np.testing.assert_allclose(half[:, j0 + 1:], full[:, j0 + 1:], rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(half[:, j0, :, 0::2], 0.5 * full[:, j0, :, 0::2], rtol=0, atol=1e-12 * scale)
+    np.testing.assert_allclose(full[:, j0, :, 1], 0.0, atol=1e-12 * scale)  # symmetric: no y share on the plane
+    assert np.abs(full[:, j0 + 1:]).max() > 0.1 * scale  # the comparison is not between zeros

@@ -17,8 +17,9 @@ The tangential velocity change is a traction-limited impulse:
 with A_i the node's share of the material's surface: by the divergence theorem
 sum_p V_p grad N_i(x_p) ~ integral over the body of grad N_i = integral over its boundary of N_i n dA,
 so the shares of the nodes near a face add up to the face's area however many layers of nodes
-touch it (for a lattice-aligned flat face exactly: the particles' midpoint rule integrates the
-piecewise-linear B-spline derivative exactly). The interface shear strength is
+touch it (for the flat top face of a lattice block exactly, to round-off: tested with 2 and 3
+particles per cell). At the edge of the contact a node's share also holds some of the free surface
+next to it: an error of order dx along the contact's perimeter. The interface shear strength is
 
     proportional:    tau = f * kappa                 (kappa = sigma_y / sqrt(3) of the material)
     constant:        tau = H0 / k0
