@@ -159,7 +159,7 @@ def test_bad_input_raises_value_error_naming_the_parameter(case):
 
 def test_bad_input_in_constructors():
     with pytest.raises(ValueError, match=r"discretisation\.cfl"):
-        Discretisation(cfl=1.01)
+        Discretisation(cfl=0.61)
     with pytest.raises(ValueError, match=r"domain\.radius_m"):
         Domain(radius_m=-1.0)
     with pytest.raises(ValueError, match=r"sliding\.speed_m_s"):
