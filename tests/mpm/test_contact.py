@@ -482,3 +482,30 @@ def test_surface_vector_mirror_fold_equals_the_full_block():
     np.testing.assert_allclose(half[:, j0, :, 0::2], 0.5 * full[:, j0, :, 0::2], rtol=0, atol=1e-12 * scale)
     np.testing.assert_allclose(full[:, j0, :, 1], 0.0, atol=1e-12 * scale)  # symmetric: no y share on the plane
     assert np.abs(full[:, j0 + 1:]).max() > 0.1 * scale  # the comparison is not between zeros
+
+
+@pytest.mark.parametrize("centre_y", [0.0, -0.3 * DX])
+def test_contact_consumes_every_folded_surface_vector(centre_y):
+    """scatter_contact_stress with the mirror fold, then sphere_contact: the contact buffer is all
+    zero afterwards, also where a folded vector lands on a partner node outside the reach (a centre
+    off the mirror plane makes the ghost and its partner lie at different distances)."""
+    from plough.mpm.grid import GHOST, MIRROR
+
+    j0, h = 5, 0.5
+    x = _lattice([2, 5, 2], [9, 8, 10], h)
+    n = x.shape[0]
+    table = pack_materials([rigid_plastic("sub", 900e6, coating=False)])
+    zeros, ones = np.zeros(n), np.ones(n)
+    radius = 3.3 * DX
+    centre = np.array([ORIGIN[0] + 5.0 * DX, centre_y, ORIGIN[2] + (10.0 - 0.3) * DX + radius])
+    cbuf = np.zeros((N_NODES, ct.N_CBUF))
+    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, zeros, np.full(n, 298.0),
+                              np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones, table,
+                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, j0, cbuf)
+    assert np.abs(cbuf[:, ct.C_AREA:]).max() > 0.1 * DX * DX  # the sphere reaches the block's surface
+    j = (np.arange(N_NODES) // SHAPE[2]) % SHAPE[1]
+    flags = np.where(j < j0, GHOST, np.where(j == j0, MIRROR, 0)).astype(np.int8)
+    out = np.zeros(ct.N_OUT)
+    ct.sphere_contact(np.ones(N_NODES), np.zeros((N_NODES, 3)), cbuf, flags, *no_memory(), ORIGIN, DX, SHAPE, centre,
+                      radius, np.array([0.1, 0.0, 0.0]), DT, ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), out)
+    np.testing.assert_array_equal(cbuf, 0.0)
