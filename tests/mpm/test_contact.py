@@ -244,11 +244,21 @@ def test_energy_account_of_contact(model, iparams):
 
 
 def test_contact_buffer_is_consumed_where_the_contact_looks_only():
+    """Within the reach every entry is consumed; outside it the stress entries are left alone, and
+    the surface vectors are consumed in the box the contact scans (a folded one may land there)."""
     case = make_case(50)
     inside, _, _, _, _ = classify(case)
     _, cbuf, _ = call(case, *MODELS[0])
     np.testing.assert_array_equal(cbuf[inside], 0.0)
-    np.testing.assert_array_equal(cbuf[~inside], case["cbuf"][~inside])
+    np.testing.assert_array_equal(cbuf[~inside, :ct.C_AREA], case["cbuf"][~inside, :ct.C_AREA])
+    reach = case["radius"] + DX
+    lo = np.maximum(np.floor((case["centre"] - reach - ORIGIN) / DX), 0)
+    hi = np.minimum(np.ceil((case["centre"] + reach - ORIGIN) / DX), SHAPE - 1)
+    ijk = np.rint((NODES - ORIGIN) / DX)
+    box = np.all((ijk >= lo) & (ijk <= hi), axis=1)
+    np.testing.assert_array_equal(cbuf[box, ct.C_AREA:], 0.0)
+    np.testing.assert_array_equal(cbuf[~box, ct.C_AREA:], case["cbuf"][~box, ct.C_AREA:])
+    assert (~inside & box).sum() > 10 and (~box).sum() > 10
 
 
 # ----------------------------------------------------------------------------- interface shear
