@@ -447,17 +447,22 @@ def _lattice(lo, hi, h):
     return ORIGIN + g * DX
 
 
-def _scatter_surface(x, h, mirror_j0=-1):
+def _scatter_block(x, h, centre, radius, mirror_j0=-1):
+    """The contact buffer of lattice particles x (cubes of edge h grid units, unstressed, all near)."""
     n = x.shape[0]
     table = pack_materials([rigid_plastic("sub", 900e6, coating=False)])
     zeros = np.zeros(n)
     ones = np.ones(n)
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    centre = ORIGIN + DX * (SHAPE - 1) / 2
-    # a sphere so large that every node is within its reach: the whole surface vector field is written
     ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, zeros, np.full(n, 298.0),
                               np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones, table,
-                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, 1.0, mirror_j0, cbuf)
+                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, mirror_j0, cbuf)
+    return cbuf
+
+
+def _scatter_surface(x, h, mirror_j0=-1):
+    # a sphere so large that every node is within its reach: the whole surface vector field is written
+    cbuf = _scatter_block(x, h, ORIGIN + DX * (SHAPE - 1) / 2, 1.0, mirror_j0)
     return cbuf[:, ct.C_AREA:ct.C_AREA + 3].reshape(*SHAPE, 3)
 
 
@@ -502,16 +507,9 @@ def test_contact_consumes_every_folded_surface_vector(centre_y):
     from plough.mpm.grid import GHOST, MIRROR
 
     j0, h = 5, 0.5
-    x = _lattice([2, 5, 2], [9, 8, 10], h)
-    n = x.shape[0]
-    table = pack_materials([rigid_plastic("sub", 900e6, coating=False)])
-    zeros, ones = np.zeros(n), np.ones(n)
     radius = 3.3 * DX
     centre = np.array([ORIGIN[0] + 5.0 * DX, centre_y, ORIGIN[2] + (10.0 - 0.3) * DX + radius])
-    cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, zeros, np.full(n, 298.0),
-                              np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones, table,
-                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, j0, cbuf)
+    cbuf = _scatter_block(_lattice([2, 5, 2], [9, 8, 10], h), h, centre, radius, j0)
     assert np.abs(cbuf[:, ct.C_AREA:]).max() > 0.1 * DX * DX  # the sphere reaches the block's surface
     j = (np.arange(N_NODES) // SHAPE[2]) % SHAPE[1]
     flags = np.where(j < j0, GHOST, np.where(j == j0, MIRROR, 0)).astype(np.int8)
