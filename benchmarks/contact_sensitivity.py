@@ -11,6 +11,9 @@ run only when missing or named in --only):
    A numerical parameter: mu_sh should not follow it.
 2. Mass-scaling ladder: ms x 4, / 4, / 16 (mass scaling / k^2 is speed / k at k times the steps,
    benchmarks/timestep_check.py): inertia, which should fade as the mass scaling falls.
+3. The same ladder at interface strength f = 0 (no interface shear) and f = 0.5: whether the
+   mass-scaling dependence belongs to the ploughing or to an interface as strong as the coating
+   (f = 1: tau = kappa, the coating's own shear strength).
 
 The same measurements of the earlier contact (shear area min(F_n / P, cell face) with a filtered
 normal force, before d23eeb2) are kept in contact_sensitivity_filtered_area.json, with a probe of
@@ -26,6 +29,7 @@ from pathlib import Path
 
 import numba
 
+from plough.materials import ProportionalShear
 from plough.mpm import contact
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
@@ -44,7 +48,8 @@ def run_case(scene: Scene, hold_wave_times: float) -> dict[str, float]:
         contact.HOLD_WAVE_TIMES = default
     row = {k: float(ds[k]) for k in KEYS}
     row.update(wall_s=float(ds.attrs["cost_wall_time_s"]), hold_wave_times=hold_wave_times,
-               mass_scaling=scene.discretisation.mass_scaling, git_commit=str(ds.attrs.get("git_commit")))
+               mass_scaling=scene.discretisation.mass_scaling, f=float(getattr(scene.interface, "f", float("nan"))),
+               git_commit=str(ds.attrs.get("git_commit")))
     return row
 
 
@@ -60,11 +65,15 @@ def main() -> None:
     ms = base.discretisation.mass_scaling
     hold = contact.HOLD_WAVE_TIMES
 
-    def with_ms(k: float) -> Scene:
-        return replace(base, discretisation=replace(base.discretisation, mass_scaling=ms * k))
+    def with_ms(k: float, f: float | None = None) -> Scene:
+        scene = base if f is None else replace(base, interface=ProportionalShear(f=f))
+        return replace(scene, discretisation=replace(base.discretisation, mass_scaling=ms * k))
 
     cases = {"defaults": (base, hold), "hold 1": (base, 1.0), "hold 4": (base, 4.0), "hold 8": (base, 8.0),
              "ms x4": (with_ms(4.0), hold), "ms/4": (with_ms(0.25), hold), "ms/16": (with_ms(1 / 16), hold)}
+    for f in (0.0, 0.5):
+        for label, k in (("ms x4", 4.0), ("ms", 1.0), ("ms/4", 0.25), ("ms/16", 1 / 16)):
+            cases[f"f {f:g} {label}"] = (with_ms(k, f), hold)
     data = json.loads(OUT.read_text()) if OUT.exists() else {}
     data["h_um"] = args.h_um
     runs = data.setdefault("runs", {})
