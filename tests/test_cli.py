@@ -59,4 +59,10 @@ def test_mpm_preset_reaches_the_solver(monkeypatch, tmp_path, capsys):
     assert seen[0].domain.radius_m == pytest.approx(170e-6)  # sized from the contact at h = 10 um
     assert (seen[1].domain.radius_m, seen[1].domain.length_m) == (200e-6, 1000e-6)
     assert not out.exists()
-    assert "recorded" in capsys.readouterr().err
+    err = capsys.readouterr().err
+    assert "recorded" in err
+    # the example's f = 1 on a perfectly plastic coating: the user is told mu follows the simulated speed
+    assert err.count("note: the interface is as strong as the perfectly plastic top layer") == 2
+    scene.write_text(scene.read_text().replace("f: 1.0", "f: 0.5"))
+    assert main(["mpm", str(scene), "-o", str(out), "--quiet"]) == 2
+    assert "note:" not in capsys.readouterr().err

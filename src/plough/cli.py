@@ -8,8 +8,12 @@ from __future__ import annotations
 import argparse
 import sys
 from collections.abc import Callable, Sequence
+from typing import TYPE_CHECKING
 
 from plough import __version__
+
+if TYPE_CHECKING:
+    from plough.mpm.scene import Scene
 
 
 class _Parser(argparse.ArgumentParser):
@@ -98,8 +102,15 @@ def _run_mpm(args: argparse.Namespace) -> int:
     except ImportError as exc:  # pragma: no cover - until the solver lands
         raise ValueError(f"the MPM solver is not available in this build: {exc}") from None
     run_scene_file(args.scene, args.output, snapshots_dir=args.snapshots, threads=args.threads,
-                   progress=not args.quiet, preset=args.preset)
+                   progress=not args.quiet, preset=args.preset, on_scene=_note_interface)
     return 0
+
+
+def _note_interface(scene: Scene) -> None:
+    """Tell the user when the scene's mu will follow the simulated speed (``Scene.interface_sticks``)."""
+    if scene.interface_sticks:
+        print("plough: note: the interface is as strong as the perfectly plastic top layer (tau = kappa); mu and "
+              "dp then depend on the simulated speed and mass scaling (README, Interface shear)", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:

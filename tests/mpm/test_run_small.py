@@ -19,7 +19,7 @@ import xarray as xr
 import yaml
 
 from plough import cli
-from plough.mpm import contact, solver, transfers
+from plough.mpm import contact, io, solver, transfers
 from plough.mpm import run as run_module
 from plough.mpm import scene as scene_module
 from plough.mpm.run import simulate
@@ -144,6 +144,7 @@ def test_boolean_mask_has_units(tiny_run):
 def test_scene_attribute_round_trips(tiny_run, tiny_scene):
     assert Scene.from_dict(json.loads(tiny_run.attrs["scene"])) == tiny_scene
     assert tiny_run.attrs["coating_representation"] == "uncoated"
+    assert tiny_run.attrs["interface_regime"] == io.interface_regime(tiny_scene)
     assert json.loads(tiny_run.attrs["steady_window"]) == [0.5, 1.0]
     assert tiny_run.attrs["plough_version"] and tiny_run.attrs["git_commit"]
 

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 import yaml
 
-from plough.materials import DX56, ZINC_COATING, ProportionalShear, rigid_plastic
+from plough.materials import DX56, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
 from plough.mpm import io, solver
 from plough.mpm.constitutive import I_RHO
 from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
@@ -298,6 +298,31 @@ def test_interface_default_and_expected_contact():
     assert s.interface == ProportionalShear(f=1.0)
     a, dp = s.expected_contact()
     assert 0 < dp < a < s.sphere.radius_m
+
+
+def test_interface_strength_ratio_says_when_the_contact_can_stick():
+    """tau / kappa of the top layer; sticking (tau = kappa on a perfectly plastic layer) is flagged in the
+    output, because mu then follows the simulated speed (README, Interface shear)."""
+    f1 = Scene.from_dict(example_dict())  # uncoated 900 MPa, proportional f = 1
+    assert f1.interface_strength_ratio == 1.0 and f1.interface_sticks
+    assert "drag" in io.interface_regime(f1)
+    half = f1.with_(interface=ProportionalShear(f=0.5))
+    assert half.interface_strength_ratio == 0.5 and not half.interface_sticks
+    assert io.interface_regime(half) == "tau = 0.5 kappa of the top layer at yield onset"
+    # constant tau = 450 MPa / (3 sqrt 3) = 86.6 MPa against kappa = 300 MPa / sqrt 3 = 173.2 MPa of the substrate
+    const = f1.with_(interface=ConstantShear(H0_Pa=450e6))
+    assert const.interface_strength_ratio == pytest.approx(0.5, rel=1e-12) and not const.interface_sticks
+    # on a 225 MPa coating (kappa 43.3 MPa) the same tau is capped at kappa: it sticks
+    soft = Scene.from_dict(example_dict("coated_rigid_plastic"))
+    soft = soft.with_(interface=ConstantShear(H0_Pa=450e6),
+                      layers=Layers(substrate=soft.layers.substrate, coating=rigid_plastic("c225", 225e6, coating=True),
+                                    coating_thickness_m=25e-6))
+    assert soft.interface_strength_ratio == 1.0 and soft.interface_sticks
+    # a hardening coating at f = 1 has a quasi-static limit: not flagged; a pressure-dependent one has no ratio
+    zinc = Scene.from_yaml(EXAMPLES[0].parent / "zinc_coated_steel.yaml")
+    assert zinc.interface_strength_ratio is None and not zinc.interface_sticks
+    assert zinc.with_(interface=ProportionalShear(f=1.0)).interface_sticks is False
+    assert io.interface_regime(zinc).startswith("pressure-dependent")
 
 
 def test_inertia_number_of_the_reference_scene():

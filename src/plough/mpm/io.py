@@ -227,6 +227,7 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     ds.attrs["slid_distance_m"] = float(slid_total)
     ds.attrs["stopped_when_steady"] = int(slid_total < scene.sliding.distance_m)
     ds.attrs["coating_representation"] = coating_representation(scene)
+    ds.attrs["interface_regime"] = interface_regime(scene)
     return ds
 
 
@@ -243,6 +244,19 @@ def coating_representation(scene: Scene) -> str:
         return f"{full} full particle layer(s) of coating (t/h = {ratio:g})"
     return (f"{full} full particle layer(s) of coating plus one layer that straddles the interface and carries "
             f"the volume-weighted mix (coating fraction {rest:.3g}); t/h = {ratio:.3g}")
+
+
+def interface_regime(scene: Scene) -> str:
+    """What the interface can do at this scene's strength: said in the output, since at tau = kappa on a
+    perfectly plastic layer mu and dp depend on the simulated speed (``Scene.interface_sticks``)."""
+    ratio = scene.interface_strength_ratio
+    if ratio is None:
+        return "pressure-dependent interface shear (tau = Cp P^np, capped at the contacting material's kappa)"
+    if scene.interface_sticks:
+        return ("tau = kappa of a perfectly plastic top layer: the contact can stick and drag the layer along; "
+                "mu and dp depend on the simulated speed and mass scaling (no quasi-static limit; README, "
+                "Interface shear)")
+    return f"tau = {ratio:.3g} kappa of the top layer at yield onset"
 
 
 def write_result(ds: xr.Dataset, path: str | Path) -> Path:

@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import numba
@@ -184,10 +185,13 @@ def apply_preset(scene: Scene, preset: str | None) -> Scene:
 
 
 def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir: str | Path | None = None,
-                   threads: int | None = None, progress: bool = True, preset: str | None = None) -> Path:
+                   threads: int | None = None, progress: bool = True, preset: str | None = None,
+                   on_scene: Callable[[Scene], None] | None = None) -> Path:
     """Read a scene YAML, apply the optional preset, simulate, write the netCDF atomically
-    (nothing is written on failure)."""
+    (nothing is written on failure). ``on_scene`` sees the validated scene before the run."""
     scene = apply_preset(Scene.from_yaml(Path(scene_path)), preset)
+    if on_scene is not None:
+        on_scene(scene)
     ds = simulate(scene, progress=progress, snapshots_dir=snapshots_dir, threads=threads)
     return io.write_result(ds, output)
 

@@ -22,6 +22,7 @@ import yaml
 from plough.materials import (
     ROOM_TEMPERATURE_K,
     BoundaryLayerShear,
+    ConstantFlow,
     ConstantShear,
     Interface,
     Material,
@@ -29,6 +30,7 @@ from plough.materials import (
     get_material,
     interface_from_dict,
     interface_to_dict,
+    reference_flow_stress,
     representative_hardness,
     rigid_plastic,
 )
@@ -369,6 +371,34 @@ class Scene:
         ms, v = self.discretisation.mass_scaling, self.sliding.speed_m_s
         layers = [self.layers.substrate] + ([self.layers.coating] if self.layers.coated else [])
         return max(ms * m.density_kg_m3 * v * v / representative_hardness(m) for m in layers)
+
+    @property
+    def interface_strength_ratio(self) -> float | None:
+        """tau / kappa of the top layer at the onset of yield (kappa = sigma_y(0) / sqrt 3); None when
+        tau follows the contact pressure (boundary-layer interface). The solver caps tau at kappa, so
+        the ratio is at most 1."""
+        top = self.layers.coating if self.layers.coated else self.layers.substrate
+        itf = self.interface
+        if isinstance(itf, ProportionalShear):
+            return itf.f
+        if isinstance(itf, ConstantShear):
+            kappa = reference_flow_stress(top.flow, 0.0) / math.sqrt(3.0)
+            return min(itf.tau_Pa / kappa, 1.0)
+        return None
+
+    @property
+    def interface_sticks(self) -> bool:
+        """Whether the interface is as strong as a perfectly plastic top layer (tau = kappa).
+
+        The contact can then stick and shear the layer just below the surface instead of slipping,
+        and how much of it the sphere drags along is set by the inertia: mu and dp follow the
+        simulated speed and mass scaling without a quasi-static limit (README, *Interface shear*:
+        mu 0.395 / 0.488 / 0.541 / 0.602 for mass scaling x 4 / 1 / (/ 4) / (/ 16) at f = 1, flat
+        within 3% at f = 0, settling at f = 0.5).
+        """
+        top = self.layers.coating if self.layers.coated else self.layers.substrate
+        ratio = self.interface_strength_ratio
+        return ratio is not None and ratio >= 1.0 - 1e-12 and isinstance(top.flow, ConstantFlow)
 
     @property
     def start_x_m(self) -> float:
