@@ -62,7 +62,7 @@ def test_mpm_preset_reaches_the_solver(monkeypatch, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "recorded" in err
     # the example's f = 1 on a perfectly plastic coating: the user is told mu follows the simulated speed
-    assert err.count("note: the interface is as strong as the perfectly plastic top layer") == 2
+    assert err.count("note: the interface is as strong as the perfectly plastic surface") == 2
     scene.write_text(scene.read_text().replace("f: 1.0", "f: 0.5"))
     assert main(["mpm", str(scene), "-o", str(out), "--quiet"]) == 2
     assert "note:" not in capsys.readouterr().err

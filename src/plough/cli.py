@@ -109,8 +109,9 @@ def _run_mpm(args: argparse.Namespace) -> int:
 def _note_interface(scene: Scene) -> None:
     """Tell the user when the scene's mu will follow the simulated speed (``Scene.interface_sticks``)."""
     if scene.interface_sticks:
-        print("plough: note: the interface is as strong as the perfectly plastic top layer (tau = kappa); mu and "
-              "dp then depend on the simulated speed and mass scaling (README, Interface shear)", file=sys.stderr)
+        print("plough: note: the interface is as strong as the perfectly plastic surface (tau = kappa); mu then "
+              "follows the simulated speed and mass scaling without settling (README, Interface shear)",
+              file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -17,7 +17,7 @@ import pytest
 import yaml
 
 from plough.materials import DX56, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
-from plough.mpm import io, solver
+from plough.mpm import contact, io, solver
 from plough.mpm.constitutive import I_RHO
 from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
 
@@ -308,7 +308,7 @@ def test_interface_strength_ratio_says_when_the_contact_can_stick():
     assert "drag" in io.interface_regime(f1)
     half = f1.with_(interface=ProportionalShear(f=0.5))
     assert half.interface_strength_ratio == 0.5 and not half.interface_sticks
-    assert io.interface_regime(half) == "tau = 0.5 kappa of the top layer at yield onset"
+    assert io.interface_regime(half).startswith("tau = 0.5 kappa")
     # constant tau = 450 MPa / (3 sqrt 3) = 86.6 MPa against kappa = 300 MPa / sqrt 3 = 173.2 MPa of the substrate
     const = f1.with_(interface=ConstantShear(H0_Pa=450e6))
     assert const.interface_strength_ratio == pytest.approx(0.5, rel=1e-12) and not const.interface_sticks
@@ -323,6 +323,46 @@ def test_interface_strength_ratio_says_when_the_contact_can_stick():
     assert zinc.interface_strength_ratio is None and not zinc.interface_sticks
     assert zinc.with_(interface=ProportionalShear(f=1.0)).interface_sticks is False
     assert io.interface_regime(zinc).startswith("pressure-dependent")
+    capped = zinc.with_(interface=ConstantShear(H0_Pa=450e6))  # tau 86.6 MPa above the zinc coating's kappa
+    assert capped.interface_strength_ratio == 1.0 and not capped.interface_sticks
+    assert "strain-hardening" in io.interface_regime(capped)
+
+
+def _coated_constant_scene(t_um: float, hc_MPa: float, hs_MPa: float, h_um: float = 10.0) -> Scene:
+    d = example_dict("coated_rigid_plastic")
+    d["layers"] = {"coating_thickness_um": t_um, "coating": {"rigid_plastic_hardness_MPa": hc_MPa},
+                   "substrate": {"rigid_plastic_hardness_MPa": hs_MPa}}
+    d["interface"] = {"model": "constant", "H0_MPa": 450}
+    d["discretisation"]["particle_size_um"] = h_um
+    return Scene.from_dict(d)
+
+
+@pytest.mark.parametrize("t_um", [25.0, 5.0, 2.0])
+def test_interface_strength_ratio_is_the_solvers_tau_over_kappa_on_the_top_particle(t_um):
+    """A coating thinner than a particle: the top particle is the volume-weighted mix, and the ratio
+    follows the solver's own kappa of that particle (450 MPa coating on 900 MPa, constant tau 86.6 MPa)."""
+    from plough.mpm.constitutive import mixed_flow_stress
+
+    scene = _coated_constant_scene(t_um, 450.0, 900.0)
+    state, const = solver.init(scene)
+    p = state.particles
+    top = int(np.argmax(p.x[:, 2]))
+    kappa = mixed_flow_stress(const.table[p.mat_a[top]], const.table[p.mat_b[top]], p.frac_a[top], 0.0, 0.0,
+                              p.temperature[top]) / math.sqrt(3.0)
+    tau = contact.interface_shear(const.interface_model, const.interface_params, 0.0, kappa)
+    assert scene.interface_strength_ratio == pytest.approx(tau / kappa, rel=1e-12)
+    assert scene.interface_sticks == (t_um == 25.0)  # 25 um: tau = kappa of the coating; thinner: the mix is harder
+
+
+def test_interface_ratio_counts_the_substrate_once_the_sphere_ploughs_through():
+    """900 MPa coating 2 um thick on a 450 MPa substrate: the expected groove (9.5 um) reaches the
+    substrate, whose kappa equals the constant tau: it sticks although the top particle does not."""
+    scene = _coated_constant_scene(2.0, 900.0, 450.0)
+    assert scene.expected_contact()[1] > 2e-6
+    assert scene.interface_strength_ratio == 1.0 and scene.interface_sticks
+    thick = _coated_constant_scene(100.0, 900.0, 450.0)
+    assert thick.expected_contact()[1] < 100e-6
+    assert thick.interface_strength_ratio == pytest.approx(0.5, rel=1e-12) and not thick.interface_sticks
 
 
 def test_inertia_number_of_the_reference_scene():

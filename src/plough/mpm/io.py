@@ -253,10 +253,11 @@ def interface_regime(scene: Scene) -> str:
     if ratio is None:
         return "pressure-dependent interface shear (tau = Cp P^np, capped at the contacting material's kappa)"
     if scene.interface_sticks:
-        return ("tau = kappa of a perfectly plastic top layer: the contact can stick and drag the layer along; "
-                "mu and dp depend on the simulated speed and mass scaling (no quasi-static limit; README, "
-                "Interface shear)")
-    return f"tau = {ratio:.3g} kappa of the top layer at yield onset"
+        return ("tau = kappa of a perfectly plastic surface the sphere touches: the contact can stick and drag it "
+                "along; mu follows the simulated speed and mass scaling without settling (README, Interface shear)")
+    if ratio >= 1.0:
+        return "tau capped at kappa of a strain-hardening surface (speed dependence not measured)"
+    return f"tau = {ratio:.3g} kappa (largest over the surfaces the sphere touches, at yield onset)"
 
 
 def write_result(ds: xr.Dataset, path: str | Path) -> Path:
