@@ -1,0 +1,66 @@
+"""Convergence in the particle size of the coated scene at interface strengths f = 0 and 0.5.
+
+    python benchmarks/interface_convergence.py [--sizes-um 20 10 5] [--f 0 0.5]
+
+Coated rigid-plastic scene (examples/coated_rigid_plastic.yaml: H~ = 0.5, t = 25 um, r = 0.2 mm,
+3 N; sized block, defaults otherwise, 2 threads) with the interface shear tau = f kappa. At f = 1
+(the scene's own interface, benchmarks/work_precision.py) mu follows the simulated speed
+(README, *Interface shear*); this asks whether the ploughing alone (f = 0) and a slipping interface
+(f = 0.5) converge in h, and to what, against the analytical model. Writes
+benchmarks/results/interface_convergence.json (a case already there is kept).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import numba
+
+from plough.analytical import ploughing
+from plough.materials import ProportionalShear
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "benchmarks" / "results" / "interface_convergence.json"
+KEYS = ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--sizes-um", type=float, nargs="+", default=[20.0, 10.0, 5.0])
+    parser.add_argument("--f", type=float, nargs="+", default=[0.0, 0.5])
+    args = parser.parse_args()
+    numba.set_num_threads(2)
+    base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml")
+    data = json.loads(OUT.read_text()) if OUT.exists() else {"runs": {}}
+    runs = data["runs"]
+    for f in args.f:
+        ref = ploughing(base.load_N, base.sphere.radius_m, base.layers.coating_thickness_m,
+                        3 * base.layers.coating.flow.sigma_y_Pa, 3 * base.layers.substrate.flow.sigma_y_Pa,
+                        k1=125.0, interface="proportional", f=f)
+        data[f"analytical f {f:g}"] = {"mu": float(ref.mu), "mu_pl": float(ref.mu_pl), "mu_sh": float(ref.mu_sh),
+                                       "dp": float(ref.dp)}
+        for h in args.sizes_um:
+            name = f"f {f:g} h {h:g}"
+            if name in runs:
+                continue
+            scene = replace(base, interface=ProportionalShear(f=f),
+                            discretisation=replace(base.discretisation, particle_size_m=h * 1e-6)).with_sized_domain()
+            ds = simulate(scene, progress=False)
+            runs[name] = {k: float(ds[k]) for k in KEYS}
+            runs[name].update(f=f, h_um=h, wall_s=float(ds.attrs["cost_wall_time_s"]),
+                              particles=int(ds.attrs["cost_particles"]), git_commit=str(ds.attrs.get("git_commit")))
+            print(name, json.dumps(runs[name]), flush=True)
+            OUT.write_text(json.dumps(data, indent=2) + "\n")
+    OUT.write_text(json.dumps(data, indent=2) + "\n")
+    print(f"{'case':12s} {'mu':>6s} {'mu_pl':>6s} {'mu_sh':>6s} {'dp um':>6s} {'wall s':>7s}")
+    for name, r in runs.items():
+        print(f"{name:12s} {r['mu']:6.3f} {r['mu_pl']:6.3f} {r['mu_sh']:6.3f} {r['dp'] * 1e6:6.2f} {r['wall_s']:7.1f}")
+
+
+if __name__ == "__main__":
+    main()
