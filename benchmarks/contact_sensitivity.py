@@ -28,6 +28,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numba
+from common import coated_reference
 
 from plough.materials import ProportionalShear
 from plough.mpm import contact
@@ -59,9 +60,7 @@ def main() -> None:
     parser.add_argument("--only", nargs="*", default=None, help="(re)run only these cases")
     args = parser.parse_args()
     numba.set_num_threads(2)
-    base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml")
-    base = replace(base, discretisation=replace(base.discretisation, particle_size_m=args.h_um * 1e-6))
-    base = base.with_sized_domain()
+    base = coated_reference(args.h_um)
     ms = base.discretisation.mass_scaling
     hold = contact.HOLD_WAVE_TIMES
 

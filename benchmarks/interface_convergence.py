@@ -18,6 +18,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numba
+from common import coated_reference
 
 from plough.analytical import ploughing
 from plough.materials import ProportionalShear
@@ -48,8 +49,7 @@ def main() -> None:
             name = f"f {f:g} h {h:g}"
             if name in runs:
                 continue
-            scene = replace(base, interface=ProportionalShear(f=f),
-                            discretisation=replace(base.discretisation, particle_size_m=h * 1e-6)).with_sized_domain()
+            scene = replace(coated_reference(h), interface=ProportionalShear(f=f))
             ds = simulate(scene, progress=False)
             runs[name] = {k: float(ds[k]) for k in KEYS}
             runs[name].update(f=f, h_um=h, wall_s=float(ds.attrs["cost_wall_time_s"]),

@@ -23,6 +23,7 @@ from pathlib import Path
 
 import numba
 import numpy as np
+from common import coated_reference
 
 from plough.materials import ProportionalShear
 from plough.mpm import solver
@@ -58,9 +59,7 @@ def main() -> None:
     parser.add_argument("--h-um", type=float, default=20.0)
     args = parser.parse_args()
     numba.set_num_threads(2)
-    base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml")
-    base = replace(base, discretisation=replace(base.discretisation, particle_size_m=args.h_um * 1e-6))
-    base = base.with_sized_domain()
+    base = coated_reference(args.h_um)
     ms = base.discretisation.mass_scaling
     runs = {}
     print(f"{'f':>4s} {'ms':>8s} " + " ".join(f"{'dx' + str(k + 1) + ' um':>8s}" for k in range(LAYERS))
