@@ -6,7 +6,8 @@ Coated rigid-plastic scene (examples/coated_rigid_plastic.yaml: H~ = 0.5, t = 25
 3 N; sized block, defaults otherwise, 2 threads) with the interface shear tau = f kappa. At f = 1
 (the scene's own interface, benchmarks/work_precision.py) mu follows the simulated speed
 (README, *Interface shear*); this asks whether the ploughing alone (f = 0) and a slipping interface
-(f = 0.5) converge in h, and to what, against the analytical model. Writes
+(f = 0.5) converge in h, and to what (extrapolated to h -> 0 with plough.study's Richardson rule),
+against the analytical model. Writes
 benchmarks/results/interface_convergence.json (a case already there is kept).
 """
 
@@ -18,12 +19,14 @@ from dataclasses import replace
 from pathlib import Path
 
 import numba
+import numpy as np
 from common import coated_reference
 
 from plough.analytical import ploughing
 from plough.materials import ProportionalShear
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
+from plough.study.extrapolation import extrapolate
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "interface_convergence.json"
@@ -56,6 +59,18 @@ def main() -> None:
                               particles=int(ds.attrs["cost_particles"]), git_commit=str(ds.attrs.get("git_commit")))
             print(name, json.dumps(runs[name]), flush=True)
             OUT.write_text(json.dumps(data, indent=2) + "\n")
+    for f in args.f:
+        sizes = [h for h in args.sizes_um if f"f {f:g} h {h:g}" in runs]
+        if len(sizes) < 2:
+            continue
+        ex = {}
+        for q in ("mu", "dp"):
+            e = extrapolate(np.array(sizes) * 1e-6, [runs[f"f {f:g} h {h:g}"][q] for h in sizes])
+            ex[q] = {"value": float(e.value), "uncertainty": float(e.uncertainty), "order": float(e.order),
+                     "method": "richardson" if int(e.method) == 0 else "least squares (flagged)"}
+            print(f"f = {f:g}: {q} extrapolated to h -> 0: {float(e.value):.4g} +- {float(e.uncertainty):.2g} "
+                  f"({ex[q]['method']}, order {float(e.order):.2f})")
+        data[f"extrapolated f {f:g}"] = ex
     OUT.write_text(json.dumps(data, indent=2) + "\n")
     print(f"{'case':12s} {'mu':>6s} {'mu_pl':>6s} {'mu_sh':>6s} {'dp um':>6s} {'wall s':>7s}")
     for name, r in runs.items():
