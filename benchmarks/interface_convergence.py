@@ -37,6 +37,8 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[20.0, 10.0, 5.0])
     parser.add_argument("--f", type=float, nargs="+", default=[0.0, 0.5])
+    parser.add_argument("--inertia-h-um", type=float, default=None,
+                        help="also run speed / 2 at this size (issue 3's inertia check against the h change)")
     args = parser.parse_args()
     numba.set_num_threads(2)
     base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml")
@@ -48,11 +50,15 @@ def main() -> None:
                         k1=125.0, interface="proportional", f=f)
         data[f"analytical f {f:g}"] = {"mu": float(ref.mu), "mu_pl": float(ref.mu_pl), "mu_sh": float(ref.mu_sh),
                                        "dp": float(ref.dp)}
-        for h in args.sizes_um:
-            name = f"f {f:g} h {h:g}"
+        cases = [(h, 1.0) for h in args.sizes_um]
+        if args.inertia_h_um is not None:
+            cases.append((args.inertia_h_um, 0.5))
+        for h, speed in cases:
+            name = f"f {f:g} h {h:g}" + ("" if speed == 1.0 else f" speed x{speed:g}")
             if name in runs:
                 continue
             scene = replace(coated_reference(h), interface=ProportionalShear(f=f))
+            scene = replace(scene, sliding=replace(scene.sliding, speed_m_s=scene.sliding.speed_m_s * speed))
             ds = simulate(scene, progress=False)
             runs[name] = {k: float(ds[k]) for k in KEYS}
             runs[name].update(f=f, h_um=h, wall_s=float(ds.attrs["cost_wall_time_s"]),
@@ -61,6 +67,11 @@ def main() -> None:
             OUT.write_text(json.dumps(data, indent=2) + "\n")
     for f in args.f:
         sizes = [h for h in args.sizes_um if f"f {f:g} h {h:g}" in runs]
+        slow = runs.get(f"f {f:g} h {args.inertia_h_um:g} speed x0.5") if args.inertia_h_um else None
+        if slow is not None:
+            fast = runs[f"f {f:g} h {args.inertia_h_um:g}"]
+            print(f"f = {f:g}, h = {args.inertia_h_um:g} um, speed / 2: mu {slow['mu'] / fast['mu'] - 1:+.1%}, "
+                  f"dp {slow['dp'] / fast['dp'] - 1:+.1%}")
         if len(sizes) < 2:
             continue
         ex = {}
