@@ -42,7 +42,8 @@ def main() -> None:
         ds = simulate(s, progress=False)
         rows[name] = {k: float(ds[k]) for k in ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")}
         rows[name].update(wall_s=ds.attrs["cost_wall_time_s"], particles=int(ds.attrs["cost_particles"]),
-                          steps=int(ds.attrs["cost_steps"]), inertia_number=s.inertia_number)
+                          steps=int(ds.attrs["cost_steps"]), inertia_number=s.inertia_number,
+                          git_commit=str(ds.attrs.get("git_commit")))
         print(name, json.dumps(rows[name]), flush=True)
         out.write_text(json.dumps(rows, indent=2) + "\n")
 
