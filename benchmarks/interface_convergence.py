@@ -23,7 +23,7 @@ import numpy as np
 from common import coated_reference
 
 from plough.analytical import ploughing
-from plough.materials import ProportionalShear
+from plough.materials import ProportionalShear, representative_hardness
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 from plough.study.extrapolation import extrapolate
@@ -46,7 +46,7 @@ def main() -> None:
     runs = data["runs"]
     for f in args.f:
         ref = ploughing(base.load_N, base.sphere.radius_m, base.layers.coating_thickness_m,
-                        3 * base.layers.coating.flow.sigma_y_Pa, 3 * base.layers.substrate.flow.sigma_y_Pa,
+                        representative_hardness(base.layers.coating), representative_hardness(base.layers.substrate),
                         k1=125.0, interface="proportional", f=f)
         data[f"analytical f {f:g}"] = {"mu": float(ref.mu), "mu_pl": float(ref.mu_pl), "mu_sh": float(ref.mu_sh),
                                        "dp": float(ref.dp)}

@@ -248,7 +248,7 @@ def coating_representation(scene: Scene) -> str:
 
 def interface_regime(scene: Scene) -> str:
     """What the interface can do at this scene's strength: said in the output, since at tau = kappa on a
-    perfectly plastic layer mu and dp depend on the simulated speed (``Scene.interface_sticks``)."""
+    perfectly plastic layer mu follows the simulated speed without settling (``Scene.interface_sticks``)."""
     ratio = scene.interface_strength_ratio
     if ratio is None:
         return "pressure-dependent interface shear (tau = Cp P^np, capped at the contacting material's kappa)"

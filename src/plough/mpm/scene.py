@@ -397,17 +397,23 @@ class Scene:
             surfaces.append((kappa(sub), isinstance(sub.flow, ConstantFlow)))
         return surfaces
 
+    def _surface_ratios(self) -> list[tuple[float, bool]] | None:
+        """(tau / kappa capped at 1, perfectly plastic?) per surface of ``_contact_surfaces``; None when tau
+        follows the contact pressure (boundary-layer interface)."""
+        itf = self.interface
+        if isinstance(itf, ProportionalShear):
+            return [(itf.f, plastic) for _, plastic in self._contact_surfaces()]
+        if isinstance(itf, ConstantShear):
+            return [(min(itf.tau_Pa / k, 1.0), plastic) for k, plastic in self._contact_surfaces()]
+        return None
+
     @property
     def interface_strength_ratio(self) -> float | None:
         """Largest tau / kappa over the surfaces the sphere can touch (``_contact_surfaces``); None when tau
         follows the contact pressure (boundary-layer interface). The solver caps tau at kappa, so the
         ratio is at most 1."""
-        itf = self.interface
-        if isinstance(itf, ProportionalShear):
-            return itf.f
-        if isinstance(itf, ConstantShear):
-            return max(min(itf.tau_Pa / k, 1.0) for k, _ in self._contact_surfaces())
-        return None
+        ratios = self._surface_ratios()
+        return None if ratios is None else max(r for r, _ in ratios)
 
     @property
     def interface_sticks(self) -> bool:
@@ -419,12 +425,7 @@ class Scene:
         The threshold is exact: tau = 0.99 kappa is not flagged, though it was not measured. A
         hardening layer is not flagged either: its strength grows under the sphere (not measured).
         """
-        itf = self.interface
-        if isinstance(itf, ProportionalShear):
-            return itf.f >= 1.0 and any(plastic for _, plastic in self._contact_surfaces())
-        if isinstance(itf, ConstantShear):
-            return any(plastic and itf.tau_Pa >= k for k, plastic in self._contact_surfaces())
-        return False
+        return any(r >= 1.0 and plastic for r, plastic in self._surface_ratios() or [])
 
     @property
     def start_x_m(self) -> float:
