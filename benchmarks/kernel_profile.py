@@ -1,6 +1,6 @@
 """Where the time of an MPM step goes, kernel by kernel, and the memory-bandwidth bound.
 
-    python benchmarks/kernel_profile.py [--h-um 5] [--threads 2] [--steps 400]
+    python benchmarks/kernel_profile.py [--h-um 5] [--threads 2] [--steps 400] [--paper-block] [--out FILE]
 
 Runs the reference scene (examples/uncoated_rigid_plastic.yaml, sized block or --paper-block) through the press
 and into the slide, then times ``--steps`` steps with every kernel the step calls wrapped in a
@@ -55,6 +55,8 @@ def main() -> None:
     parser.add_argument("--paper-block", action="store_true", help="the paper's 0.2 x 1 mm block, not the sized one")
     parser.add_argument("--bandwidth-GB-s", type=float, default=43.0,
                         help="STREAM triad bandwidth of the machine (../shared/peer-bench/bandwidth.py)")
+    parser.add_argument("--out", type=Path, default=None,
+                        help="results file (default benchmarks/results/kernel_profile_h<h>[_paper_block].json)")
     args = parser.parse_args()
     numba.set_num_threads(args.threads)
     from dataclasses import replace
@@ -117,7 +119,7 @@ def main() -> None:
     }
     block_name = "_paper_block" if args.paper_block else ""
     result["block"] = "paper" if args.paper_block else "sized"
-    out = ROOT / "benchmarks" / "results" / f"kernel_profile_h{args.h_um:g}{block_name}.json"
+    out = args.out or ROOT / "benchmarks" / "results" / f"kernel_profile_h{args.h_um:g}{block_name}.json"
     out.write_text(json.dumps(result, indent=2) + "\n")
     print(f"{n:,} particles, {const.grid.n_nodes:,} nodes, {args.threads} threads: "
           f"{n / med['step'] / 1e6:.2f} M particle-steps/s (median of {args.steps // block} blocks of {block})")

@@ -24,7 +24,8 @@ def _grooved_block(scene: Scene, depth_of_row):
     rows = np.broadcast_to(np.arange(xs.size)[:, None], X.shape)
     top = np.where(Y < 30e-6, -depth_of_row(rows), 0.0)
     x = np.stack([X.ravel(), Y.ravel(), (top - 0.5 * h).ravel()], axis=1)
-    return SimpleNamespace(x=x, J=np.ones(x.shape[0])), xs
+    n = x.shape[0]
+    return SimpleNamespace(x=x, J=np.ones(n), vol0=np.full(n, h**3), n=n), xs
 
 
 @pytest.fixture
@@ -58,3 +59,18 @@ def test_a_number_of_sections_is_kept(scene):
     _, z, sections = residual_profiles(p, s, s.start_x_m + s.sliding.distance_m, 50e-6)
     assert sections.size == 3
     assert np.nanmin(z) == pytest.approx(-2e-6, rel=1e-12)
+
+
+def test_coarse_particles_are_sampled_on_the_fine_columns():
+    """A 2 h particle's top face gives four h-wide samples at its quarter points, at z + h J^(1/3)."""
+    from plough.mpm.io import surface_samples
+
+    h = 1e-5
+    x = np.array([[0.5 * h, 0.5 * h, -0.5 * h], [3 * h, 3 * h, -h]])
+    vol0 = np.array([h**3, 8 * h**3])
+    J = np.array([1.0, 1.331])
+    sx, sy, top, index = surface_samples(SimpleNamespace(x=x, vol0=vol0, J=J, n=2), h)
+    assert sx.size == 5 and list(index) == [0, 1, 1, 1, 1]
+    np.testing.assert_allclose(top, [0.0] + [-h + h * 1.1] * 4, atol=1e-18)
+    np.testing.assert_allclose(sorted(sx[1:]), [3 * h - 0.55 * h] * 2 + [3 * h + 0.55 * h] * 2)
+    np.testing.assert_allclose(sorted(sy[1:]), [3 * h - 0.55 * h] * 2 + [3 * h + 0.55 * h] * 2)

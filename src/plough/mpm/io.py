@@ -72,6 +72,28 @@ def _y_edges(scene: Scene) -> np.ndarray:
     return np.arange(0.0 if scene.domain.symmetric else -y_max, y_max + 0.5 * h, h)
 
 
+def surface_samples(p: Particles, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(x, y, top, index) with one sample per h x h column of every particle's top face.
+
+    A lattice particle (edge h) gives one sample; a graded far-field particle (edge 2 h) gives four,
+    at its quarter points in x and y, so bands and bins one h wide see every particle as they would
+    on the uniform lattice. ``top`` is the top face z + e J^(1/3) / 2 (edge e = vol0^(1/3)) and
+    ``index`` the particle each sample belongs to.
+    """
+    edge = np.cbrt(p.vol0)
+    top = p.x[:, 2] + 0.5 * edge * np.cbrt(p.J)
+    coarse = edge > 1.5 * h
+    if not coarse.any():
+        return p.x[:, 0], p.x[:, 1], top, np.arange(p.n)
+    ci = np.flatnonzero(coarse)
+    offsets = np.array([[-1, -1], [-1, 1], [1, -1], [1, 1]]) * 0.5 * h
+    sx = (p.x[ci, 0][:, None] + offsets[:, 0] * np.cbrt(p.J[ci])[:, None]).ravel()
+    sy = (p.x[ci, 1][:, None] + offsets[:, 1] * np.cbrt(p.J[ci])[:, None]).ravel()
+    fi = np.flatnonzero(~coarse)
+    index = np.concatenate([fi, np.repeat(ci, 4)])
+    return (np.concatenate([p.x[fi, 0], sx]), np.concatenate([p.x[fi, 1], sy]), top[index], index)
+
+
 def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float,
                       distance_m: float | None = None) -> tuple:
     """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
@@ -96,11 +118,11 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
     sections = np.linspace(x_lo, x_hi, n_sections) if n_sections > 1 else np.array([0.5 * (x_lo + x_hi)])
     edges = _y_edges(scene)
     centres = 0.5 * (edges[1:] + edges[:-1])
-    top = p.x[:, 2] + 0.5 * h * np.cbrt(p.J)  # the top face of each particle's cube
+    sx, sy, top, _ = surface_samples(p, h)
     profiles = []
     for xs in sections:
-        band = np.abs(p.x[:, 0] - xs) < 0.5 * h
-        idx = np.clip(np.digitize(p.x[band, 1], edges) - 1, 0, centres.size - 1)
+        band = np.abs(sx - xs) < 0.5 * h
+        idx = np.clip(np.digitize(sy[band], edges) - 1, 0, centres.size - 1)
         z = np.full(centres.size, -np.inf)
         np.maximum.at(z, idx, top[band])
         profiles.append(z)
@@ -123,11 +145,11 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
     h = scene.discretisation.particle_size_m
     x, y, z = p.x[:, 0], p.x[:, 1], p.x[:, 2]
     coat = np.where(p.mat_a == coating_row, p.frac_a, 0.0).astype(np.float32)
-    top = z + 0.5 * h * np.cbrt(p.J)
+    sx, sy, top, sample_of = surface_samples(p, h)
     xs_edges = np.arange(scene.start_x_m - 2.0 * contact_radius, sphere_centre[0] + 2.0 * contact_radius + h, h)
     ys_edges = np.arange(0.0 if scene.domain.symmetric else -3.0 * contact_radius, 3.0 * contact_radius + h, h)
-    ix = np.digitize(x, xs_edges) - 1
-    iy = np.digitize(y, ys_edges) - 1
+    ix = np.digitize(sx, xs_edges) - 1
+    iy = np.digitize(sy, ys_edges) - 1
     ok = (ix >= 0) & (ix < xs_edges.size - 1) & (iy >= 0) & (iy < ys_edges.size - 1)
     hmap = np.full((xs_edges.size - 1, ys_edges.size - 1), -np.inf)
     np.maximum.at(hmap, (ix[ok], iy[ok]), top[ok])
@@ -135,12 +157,13 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
 
     depth = scene.outputs.buried_profile_depth_m
     y_edges = _y_edges(scene)  # the bins of residual_profiles: profile_z and buried_profile_z share y
-    in_sections = np.zeros(p.n, dtype=bool)
+    in_sections = np.zeros(sx.size, dtype=bool)
     for xs in sections:
-        in_sections |= np.abs(x - xs) < 0.5 * h
-    line = in_sections & (np.abs(p.z0 + depth) <= 0.5 * h + 1e-12)
-    iyl = np.clip(np.digitize(y[line], y_edges) - 1, 0, y_edges.size - 2)
-    total = np.bincount(iyl, weights=(z - p.z0)[line], minlength=y_edges.size - 1)
+        in_sections |= np.abs(sx - xs) < 0.5 * h
+    half_edge = 0.5 * np.cbrt(p.vol0)
+    line = in_sections & (np.abs(p.z0 + depth) <= half_edge + 1e-12)[sample_of]
+    iyl = np.clip(np.digitize(sy[line], y_edges) - 1, 0, y_edges.size - 2)
+    total = np.bincount(iyl, weights=(z - p.z0)[sample_of[line]], minlength=y_edges.size - 1)
     count = np.bincount(iyl, minlength=y_edges.size - 1)
     buried = np.where(count > 0, -depth + total / np.maximum(count, 1), np.nan)
 
@@ -241,9 +264,14 @@ def coating_representation(scene: Scene) -> str:
     full = int(np.floor(ratio + 1e-9))  # t = 30e-6, h = 10e-6 is 3 layers despite round-off
     rest = ratio - full
     if rest < 1e-9:
-        return f"{full} full particle layer(s) of coating (t/h = {ratio:g})"
-    return (f"{full} full particle layer(s) of coating plus one layer that straddles the interface and carries "
-            f"the volume-weighted mix (coating fraction {rest:.3g}); t/h = {ratio:.3g}")
+        text = f"{full} full particle layer(s) of coating (t/h = {ratio:g})"
+    else:
+        text = (f"{full} full particle layer(s) of coating plus one layer that straddles the interface and carries "
+                f"the volume-weighted mix (coating fraction {rest:.3g}); t/h = {ratio:.3g}")
+    if scene.discretisation.graded:
+        text += (f"; outside the fine zone (graded particles of 2 h) the same rule with t/(2h) = {0.5 * ratio:.3g}, "
+                 "the coating's volume kept exactly")
+    return text
 
 
 def interface_regime(scene: Scene) -> str:

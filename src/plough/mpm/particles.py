@@ -6,6 +6,12 @@ The coating is the material above z = -t. A particle whose cube straddles the in
 represented faithfully rather than rounded: it carries both materials with the coating's volume
 fraction ``frac_a`` (density, elastic moduli and flow stress are volume-weighted mixes, see
 :mod:`plough.mpm.constitutive`). Pure particles have ``frac_a = 1`` and ``mat_b = mat_a``.
+
+Graded particles (``discretisation.graded``): outside the fine zone along the track, each complete
+2 x 2 x 2 group of lattice cubes (all eight inside the half cylinder) becomes one particle of edge
+2 h at the group's centre, with the group's volume, mass and coating volume fraction, so the block's
+mass, volume, coating volume and centre of mass are those of the uniform lattice exactly. A
+particle's edge is ``cbrt(vol0)``; nothing downstream assumes h.
 """
 
 from __future__ import annotations
@@ -46,8 +52,40 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
     ``densities`` gives each row's physical density (kg/m^3).
     """
     h = scene.discretisation.particle_size_m
-    R, L = scene.domain.radius_m, scene.domain.length_m
-    nx = int(round(L / h))
+    x = _lattice(scene, int(round(scene.domain.length_m / h)))
+    n = x.shape[0]
+    vol0 = np.full(n, h**3)
+    if scene.discretisation.graded:
+        x, vol0 = coarsen_far_field(x, h, _fine_half_width(scene))
+        n = x.shape[0]
+
+    t = scene.layers.coating_thickness_m
+    sub = material_rows["substrate"]
+    mat_a = np.full(n, sub, dtype=np.int32)
+    mat_b = np.full(n, sub, dtype=np.int32)
+    frac_a = np.ones(n)
+    if scene.layers.coated:
+        coat = material_rows["coating"]
+        # coating volume fraction of the cube [z - e/2, z + e/2] (edge e) above z = -t
+        edge = np.cbrt(vol0)
+        frac = np.clip((x[:, 2] + 0.5 * edge + t) / edge, 0.0, 1.0)
+        frac[np.abs(frac - 1.0) < 1e-9] = 1.0  # exact multiples of h: full layers despite round-off
+        frac[frac < 1e-9] = 0.0
+        mat_a[frac > 0] = coat
+        frac_a = np.where(frac > 0, frac, 1.0)
+    rho = frac_a * densities[mat_a] + (1.0 - frac_a) * densities[mat_b]
+    mass = rho * scene.discretisation.mass_scaling * vol0
+    return Particles(
+        x=x, v=np.zeros((n, 3)), C=np.zeros((n, 3, 3)), stress=np.zeros((n, 6)), J=np.ones(n), vol0=vol0,
+        mass=mass, eps_p=np.zeros(n), temperature=np.full(n, scene.outputs.initial_temperature_K),
+        mat_a=mat_a, mat_b=mat_b, frac_a=frac_a, near=np.zeros(n, dtype=np.int8), z0=x[:, 2].copy(),
+    )
+
+
+def _lattice(scene: Scene, nx: int) -> np.ndarray:
+    """Centres of the h-cubes of the first ``nx`` layers along x that lie in the half cylinder."""
+    h = scene.discretisation.particle_size_m
+    R = scene.domain.radius_m
     nr = int(np.ceil(R / h))
     xs = (np.arange(nx) + 0.5) * h
     ys = (np.arange(nr) + 0.5) * h
@@ -62,26 +100,47 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
     x[:, 0] = np.repeat(xs, n_cross)
     x[:, 1] = np.tile(y2, nx)
     x[:, 2] = np.tile(z2, nx)
-    n = x.shape[0]
+    return x
 
-    t = scene.layers.coating_thickness_m
-    sub = material_rows["substrate"]
-    mat_a = np.full(n, sub, dtype=np.int32)
-    mat_b = np.full(n, sub, dtype=np.int32)
-    frac_a = np.ones(n)
-    if scene.layers.coated:
-        coat = material_rows["coating"]
-        # coating volume fraction of the cube [z - h/2, z + h/2] above z = -t
-        frac = np.clip((x[:, 2] + 0.5 * h + t) / h, 0.0, 1.0)
-        frac[np.abs(frac - 1.0) < 1e-9] = 1.0  # exact multiples of h: full layers despite round-off
-        frac[frac < 1e-9] = 0.0
-        mat_a[frac > 0] = coat
-        frac_a = np.where(frac > 0, frac, 1.0)
-    rho = frac_a * densities[mat_a] + (1.0 - frac_a) * densities[mat_b]
-    vol0 = np.full(n, h**3)
-    mass = rho * scene.discretisation.mass_scaling * vol0
-    return Particles(
-        x=x, v=np.zeros((n, 3)), C=np.zeros((n, 3, 3)), stress=np.zeros((n, 6)), J=np.ones(n), vol0=vol0,
-        mass=mass, eps_p=np.zeros(n), temperature=np.full(n, scene.outputs.initial_temperature_K),
-        mat_a=mat_a, mat_b=mat_b, frac_a=frac_a, near=np.zeros(n, dtype=np.int8), z0=x[:, 2].copy(),
-    )
+
+def _fine_half_width(scene: Scene) -> float:
+    a, _ = scene.expected_contact()
+    return scene.discretisation.fine_zone_contact_radii * a
+
+
+def particle_count_ratio(scene: Scene) -> float:
+    """Particles of the scene's seeding over those of the uniform lattice (1 unless graded), from one
+    2 h slice of the block (the grading does not change along x)."""
+    if not scene.discretisation.graded:
+        return 1.0
+    h = scene.discretisation.particle_size_m
+    x = _lattice(scene, 2)
+    return coarsen_far_field(x, h, _fine_half_width(scene))[0].shape[0] / x.shape[0]
+
+
+def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float) -> tuple[np.ndarray, np.ndarray]:
+    """Merge the lattice particles outside the fine zone into particles of edge 2 h.
+
+    ``x`` are the centres of a lattice of cubes of edge h with faces on multiples of h (y and z
+    measured from the mirror plane and the surface). The fine zone is |y| <= ``fine_half_width_m``
+    and z >= -``fine_half_width_m``; a group of 2 x 2 x 2 cubes (aligned to even multiples of h) is
+    merged when all eight of its cubes exist and none lies in the fine zone. Returns the new centres
+    (sorted x-major, as the lattice was, so that thread chunks stay slabs of the block) and volumes.
+    """
+    idx = np.floor(x / h).astype(np.int64)  # cube index per axis
+    parent = np.floor_divide(idx, 2)
+    fine = (np.abs(x[:, 1]) - 0.5 * h <= fine_half_width_m) & (x[:, 2] + 0.5 * h >= -fine_half_width_m)
+    lo = parent.min(axis=0)
+    span = parent.max(axis=0) - lo + 1
+    key = ((parent[:, 0] - lo[0]) * span[1] + (parent[:, 1] - lo[1])) * span[2] + (parent[:, 2] - lo[2])
+    _, group, count = np.unique(key, return_inverse=True, return_counts=True)
+    group_fine = np.zeros(count.size, dtype=bool)
+    np.logical_or.at(group_fine, group, fine)
+    merge = (count[group] == 8) & ~group_fine[group]
+    keep = x[~merge]
+    first = np.unique(group[merge], return_index=True)[1]  # one member per merged group
+    merged = (2 * parent[merge][first] + 1).astype(float) * h  # the group's centre
+    xs = np.concatenate([keep, merged])
+    vol = np.concatenate([np.full(keep.shape[0], h**3), np.full(merged.shape[0], 8.0 * h**3)])
+    order = np.lexsort((xs[:, 2], xs[:, 1], xs[:, 0]))
+    return xs[order], vol[order]

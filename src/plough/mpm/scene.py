@@ -224,6 +224,11 @@ class Discretisation:
     :mod:`plough.mpm.transfers`); "local" uses each particle's own. Plastic flow is isochoric, and
     with "local" the block locks: on the coated reference scene at h = 20 / 10 um dp was 1.36 /
     3.69 um against 4.07 / 12.99 um projected (README, "Volumetric locking").
+
+    ``graded``: particles of size h only in the *fine zone* along the track (|y| and depth within
+    ``fine_zone_contact_radii`` expected contact radii, over the block's whole length); outside it
+    each complete 2 x 2 x 2 group of lattice particles is one particle of size 2 h (one per cell
+    at two particles per cell). The grid stays uniform. Off by default (README, "Graded particles").
     """
 
     particle_size_m: float = 10e-6
@@ -232,6 +237,8 @@ class Discretisation:
     mass_scaling: float = 1e6
     flip: float = 1.0
     dilatation: str = "projected"
+    graded: bool = False
+    fine_zone_contact_radii: float = 1.5
 
     def __post_init__(self) -> None:
         _finite_positive("discretisation", "particle_size_m", self.particle_size_m, "m")
@@ -246,6 +253,12 @@ class Discretisation:
             raise ValueError(f"discretisation.flip = {self.flip!r} is outside the allowed range [0, 1]")
         if self.dilatation not in DILATATION_MODES:
             raise ValueError(f"discretisation.dilatation = {self.dilatation!r} is not one of {list(DILATATION_MODES)}")
+        if not isinstance(self.graded, bool):
+            raise ValueError(f"discretisation.graded = {self.graded!r} must be true or false")
+        _finite_positive("discretisation", "fine_zone_contact_radii", self.fine_zone_contact_radii, "")
+        if self.graded and self.particles_per_cell < 2:
+            raise ValueError("discretisation.graded = true needs discretisation.particles_per_cell >= 2 (got "
+                             f"{self.particles_per_cell}): the far-field particles of size 2 h must not exceed a cell")
 
     @property
     def cell_size_m(self) -> float:
@@ -533,7 +546,7 @@ class Scene:
         beside the defaults."""
         return replace(self, domain=PAPER_DOMAIN,
                        sliding=replace(self.sliding, distance_m=600e-6, speed_m_s=0.1, stop_when_steady=False),
-                       discretisation=replace(self.discretisation, mass_scaling=1e6),
+                       discretisation=replace(self.discretisation, mass_scaling=1e6, graded=False),
                        outputs=replace(self.outputs, steady_window=(0.5, 1.0)))
 
     def with_(self, **changes: Any) -> Scene:

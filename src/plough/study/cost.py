@@ -2,7 +2,8 @@
 
 Used for cluster resources (``mem_mb``, ``runtime`` of the Slurm profile) and to project the
 time of the full reproduction from a measured throughput. The counts follow the solver:
-particles fill the half cylinder below z = 0 (a quarter with the mirror plane) on an h lattice;
+particles fill the half cylinder below z = 0 (a quarter with the mirror plane) on an h lattice
+(graded scenes: times the count ratio of one slice of the block);
 dt = CFL * dx / (c + 2 v) with c the mass-scaled P-wave speed of the stiffest layer; the sphere
 presses at
 ``press_speed_fraction * v`` to about the expected ploughing depth, settles, then slides.
@@ -13,6 +14,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from plough.mpm.particles import particle_count_ratio
 from plough.mpm.scene import Scene
 
 #: Bytes per particle (state arrays) plus the grid share at 2 particles per cell and 2 threads,
@@ -50,7 +52,7 @@ def estimate(scene: Scene) -> RunCost:
     h = scene.discretisation.particle_size_m
     dom = scene.domain
     cross = (0.25 if dom.symmetric else 0.5) * math.pi * dom.radius_m**2  # quarter / half disc below z = 0
-    particles = int(cross * dom.length_m / h**3)
+    particles = int(cross * dom.length_m / h**3 * particle_count_ratio(scene))
     v = scene.sliding.speed_m_s
     dt = scene.discretisation.cfl * scene.discretisation.cell_size_m / (wave_speed_m_s(scene) + 2 * v)
     _, dp = scene.expected_contact()

@@ -1,0 +1,110 @@
+"""plough.mpm.particles: graded seeding (fine particles along the track, 2 h particles elsewhere).
+
+References are the uniform lattice of the same scene: merging 2 x 2 x 2 groups must keep the
+block's mass, volume, coating volume and (for one material) centre of mass exactly, leave the fine
+zone untouched, and only merge complete groups inside the half cylinder.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from plough.mpm import solver
+from plough.mpm.particles import coarsen_far_field
+from plough.mpm.scene import Scene
+
+from .test_scene import coated_scene
+
+
+def graded(scene: Scene, k: float = 1.0) -> Scene:
+    return replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_contact_radii=k))
+
+
+@pytest.fixture(scope="module", params=[True, False], ids=["mirror", "full"])
+def pair(request):
+    """(graded scene, uniform particles, graded particles) of the coated scene, t = 25 um, h = 10 um."""
+    scene = coated_scene(symmetric=request.param)
+    uniform, _ = solver.init(scene, n_chunks=1)
+    grad, _ = solver.init(graded(scene), n_chunks=1)
+    return graded(scene), uniform.particles, grad.particles
+
+
+def test_graded_seeding_keeps_mass_volume_and_coating_volume(pair):
+    scene, u, g = pair
+    assert g.n < 0.8 * u.n  # something was merged
+    assert g.vol0.sum() == pytest.approx(u.vol0.sum(), rel=1e-12)
+    assert g.mass.sum() == pytest.approx(u.mass.sum(), rel=1e-12)
+    coat_u = (u.vol0 * np.where(u.mat_a == 0, u.frac_a, 0.0)).sum()
+    coat_g = (g.vol0 * np.where(g.mat_a == 0, g.frac_a, 0.0)).sum()
+    assert coat_g == pytest.approx(coat_u, rel=1e-12)
+    # the volume centroid is the lattice's (merged centres are their groups' centroids)
+    np.testing.assert_allclose((g.vol0[:, None] * g.x).sum(0) / g.vol0.sum(),
+                               (u.vol0[:, None] * u.x).sum(0) / u.vol0.sum(), rtol=0, atol=1e-12)
+
+
+def test_fine_zone_is_untouched_and_merged_particles_are_double_size(pair):
+    scene, u, g = pair
+    h = scene.discretisation.particle_size_m
+    a, _ = scene.expected_contact()
+    w = scene.discretisation.fine_zone_contact_radii * a
+    in_zone_u = (np.abs(u.x[:, 1]) - 0.5 * h <= w) & (u.x[:, 2] + 0.5 * h >= -w)
+    fine = np.isclose(g.vol0, h**3, rtol=1e-12, atol=0)
+    coarse = np.isclose(g.vol0, 8 * h**3, rtol=1e-12, atol=0)
+    assert np.all(fine | coarse) and coarse.sum() > 0
+    # every fine-zone lattice particle is still there, at its place
+    key = lambda x: set(map(tuple, np.rint(x / (0.5 * h)).astype(np.int64)))  # noqa: E731
+    assert key(u.x[in_zone_u]) <= key(g.x[fine])
+    assert fine.sum() == u.n - 8 * coarse.sum()
+    # coarse particles: outside the zone, centred on even lattice planes, inside the half cylinder
+    xc = g.x[coarse]
+    assert np.all((np.abs(xc[:, 1]) - h > w - 1e-12) | (xc[:, 2] + h < -w + 1e-12))
+    np.testing.assert_allclose(np.mod(xc / h, 2.0), 1.0, atol=1e-9)
+    R = scene.domain.radius_m
+    assert np.all(xc[:, 1] ** 2 + xc[:, 2] ** 2 < R * R)
+    assert np.all(np.diff(g.x[:, 0]) >= 0)  # still x-major: thread chunks are slabs
+
+
+def test_coarse_particles_straddling_the_coating_carry_its_volume_fraction():
+    """t = 15 um at h = 10 um: a 2 h particle spanning -20..0 um is 3/4 coating, -40..-20 um is pure substrate."""
+    scene = graded(coated_scene(t_um=15.0), k=0.5)
+    state, _ = solver.init(scene, n_chunks=1)
+    p = state.particles
+    h = 10e-6
+    coarse = np.isclose(p.vol0, 8 * h**3, rtol=1e-12, atol=0)
+    top = coarse & np.isclose(p.x[:, 2], -h, rtol=1e-12, atol=0)
+    assert top.sum() > 0
+    np.testing.assert_allclose(p.frac_a[top], 0.75, rtol=1e-12)
+    assert np.all(p.mat_a[top] == 0) and np.all(p.mat_b[top] == 1)
+    below = coarse & (p.x[:, 2] < -2 * h)
+    assert np.all(p.mat_a[below] == 1) and np.all(p.frac_a[below] == 1.0)
+
+
+def test_only_complete_groups_merge():
+    """Seven of the eight cubes of a group: nothing merges; all eight: one particle of 8 h^3."""
+    h = 1.0
+    cubes = np.array([[i, j, k] for i in range(2) for j in range(2) for k in range(2)], dtype=float)
+    x = (cubes + 0.5) * h + np.array([0.0, 10.0, 0.0])  # far from the fine zone at |y| <= 1
+    xs, vol = coarsen_far_field(x, h, 1.0)
+    assert xs.shape == (1, 3) and vol[0] == 8.0
+    np.testing.assert_allclose(xs[0], x.mean(0))
+    xs, vol = coarsen_far_field(x[:7], h, 1.0)
+    assert xs.shape == (7, 3) and np.all(vol == 1.0)
+
+
+def test_graded_needs_two_particles_per_cell():
+    scene = coated_scene()
+    with pytest.raises(ValueError, match="particles_per_cell"):
+        replace(scene.discretisation, graded=True, particles_per_cell=1)
+    with pytest.raises(ValueError, match="fine_zone_contact_radii"):
+        replace(scene.discretisation, fine_zone_contact_radii=0.0)
+    with pytest.raises(ValueError, match="graded"):
+        replace(scene.discretisation, graded="yes")
+
+
+def test_graded_round_trips_through_the_scene_dict():
+    scene = graded(coated_scene(), k=1.25)
+    back = Scene.from_dict(scene.to_dict())
+    assert back.discretisation.graded is True and back.discretisation.fine_zone_contact_radii == 1.25
