@@ -8,6 +8,10 @@ reference scene at 2 threads (benchmarks/results/mpm_reference_sized.json, the s
 With `--cores 2` and 2 threads per run the runs go one after another, so the total is their sum.
 Also projected: the lower bound with `mpm.skip_finest_tolerance` set, when every finest-size sweep
 run is skipped (the pictures' finest runs always run); how many are skipped depends on the results.
+With ``numerics.graded`` on, the particle counts are the graded ones and the throughput is scaled
+by the graded runs' particle-steps per second over the uniform runs' at the same scene and size
+(median over benchmarks/results/graded_particles.json, fine zone as configured): a graded run has
+fewer particles on the same grid, so the grid's share of a step grows.
 Writes benchmarks/results/reproduction_time.json and prints a Markdown table.
 """
 
@@ -16,6 +20,7 @@ from __future__ import annotations
 import argparse
 import copy
 import json
+import statistics
 from pathlib import Path
 
 import yaml
@@ -26,15 +31,39 @@ from plough.study import cost, matrix
 ROOT = Path(__file__).resolve().parents[1]
 
 
+def graded_throughput_ratio(path: Path, k: float) -> float:
+    """Median over scenes and sizes of (particle-steps/s of the graded run) / (of the uniform run)."""
+    runs = json.loads(path.read_text())["runs"]
+    ratios = []
+    for sizes in runs.values():
+        for variants in sizes.values():
+            graded, uniform = variants.get(f"graded k={k:g}"), variants.get("uniform")
+            if graded and uniform:
+                rate = [r["particles"] * r["steps"] / r["wall_s"] for r in (graded, uniform)]
+                ratios.append(rate[0] / rate[1])
+    if not ratios:
+        raise SystemExit(f"{path} has no graded run with fine_zone_contact_radii = {k:g}: run "
+                         "benchmarks/graded_particles.py first")
+    return statistics.median(ratios)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
     parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
+    parser.add_argument("--graded-measured", default=str(ROOT / "benchmarks" / "results" / "graded_particles.json"))
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
     args = parser.parse_args()
     config = yaml.safe_load(Path(args.config).read_text())
     measured = json.loads(Path(args.measured).read_text())
     throughput = min(r["particle_steps_per_s"] for r in measured["runs"])
+    numerics = config["mpm"]["numerics"]
+    graded_factor = 1.0
+    if numerics.get("graded", False):
+        k = float(numerics.get("fine_zone_contact_radii", 1.5))
+        graded_factor = graded_throughput_ratio(Path(args.graded_measured), k)
+        print(f"graded particles: throughput x {graded_factor:.3f} (graded over uniform, {args.graded_measured})")
+        throughput *= graded_factor
     by_size: dict[float, dict[str, float]] = {}
     with_skip = copy.deepcopy(config)
     with_skip["mpm"]["skip_finest_tolerance"] = 0.05
@@ -62,7 +91,8 @@ def main() -> None:
     print(f"| all | {sum(r['runs'] for r in by_size.values())} | | | {total / 3600:.1f} h ({total / 86400:.1f} days) |")
     print(f"\nwith skip_finest_tolerance, if all {len(skippable)} skippable finest runs are skipped: "
           f"{(total - skippable_s) / 3600:.1f} h (lower bound)")
-    out = {"config": args.config, "throughput_particle_steps_per_s": throughput, "by_size_um": by_size,
+    out = {"config": args.config, "throughput_particle_steps_per_s": throughput, "graded_throughput_factor":
+           graded_factor, "graded": bool(numerics.get("graded", False)), "by_size_um": by_size,
            "total_projected_s": total, "skippable_runs": len(skippable),
            "lower_bound_all_skipped_s": total - skippable_s}
     Path(args.out).write_text(json.dumps(out, indent=2) + "\n")

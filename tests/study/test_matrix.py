@@ -327,3 +327,16 @@ def test_unknown_figures_are_refused():
     with pytest.raises(ValueError, match="not a single-run figure"):
         matrix.figure_points(config, "fig15")
     assert matrix.figure_runs(config, "fig03") == []
+
+
+def test_graded_particles_reach_every_scene_of_the_matrix(config):
+    """numerics.graded / fine_zone_contact_radii go into each run's discretisation (and so into its params)."""
+    changed = copy.deepcopy(config)
+    changed["mpm"]["numerics"].update(graded=not config["mpm"]["numerics"].get("graded", False),
+                                      fine_zone_contact_radii=1.25)
+    before, after = matrix.all_runs(config), matrix.all_runs(changed)
+    assert set(before) == set(after)
+    for rid, d in after.items():
+        disc = Scene.from_dict(d).discretisation
+        assert disc.graded is changed["mpm"]["numerics"]["graded"] and disc.fine_zone_contact_radii == 1.25
+        assert d != before[rid]  # a changed scene: the workflow reruns it
