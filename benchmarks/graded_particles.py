@@ -1,6 +1,8 @@
 """Graded particles against uniform ones: what the coarse far field costs in mu and dp, and what it saves.
 
     python benchmarks/graded_particles.py [--scenes coated uncoated real] [--k 1.5 1.0] [--threads 2]
+    python benchmarks/graded_particles.py --scenes coated --sizes 10 --paper \
+        --out benchmarks/results/graded_vs_paper.json
 
 For each scene at two particle sizes (coarse, fine) runs the defaults (uniform particles) and
 ``discretisation.graded`` with the fine zone ``--k`` expected contact radii wide and deep, all on
@@ -13,7 +15,11 @@ shorter wall time. Scenes:
 - uncoated: examples/uncoated_rigid_plastic.yaml (H = 900 MPa, r = 0.2 mm, 3 N, f = 1), h = 10, 5 um;
 - real: examples/zinc_coated_steel.yaml (zinc t = 15 um on DX56, r = 0.5 mm, 22 N), h = 20, 10 um.
 
-Writes benchmarks/results/graded_particles.json after every run (a stopped invocation keeps what
+``--paper`` adds the paper's numerical setup (``Scene.with_paper_settings()``: its fixed block,
+uniform particles) at each size, for the speed-up of the defaults against it at equal error.
+``--sizes`` replaces the scenes' two sizes.
+
+Writes benchmarks/results/graded_particles.json (or ``--out``) after every run (a stopped invocation keeps what
 it measured) and prints a Markdown table.
 """
 
@@ -34,11 +40,14 @@ SCENES = {"coated": ("coated_rigid_plastic.yaml", (10.0, 5.0)),
 QUANTITIES = ("mu", "mu_pl", "mu_sh", "dp", "Fz_mean")
 
 
-def scene_at(example: str, h_um: float, k: float | None) -> Scene:
+def scene_at(example: str, h_um: float, k: float | str | None) -> Scene:
+    """Uniform (k None), graded with fine zone k, or the paper's settings (k "paper") at size h_um."""
     base = Scene.from_yaml(ROOT / "examples" / example)
     disc = replace(base.discretisation, particle_size_m=h_um * 1e-6)
+    if k == "paper":
+        return replace(base, discretisation=disc).with_paper_settings()
     if k is not None:
-        disc = replace(disc, graded=True, fine_zone_contact_radii=k)
+        disc = replace(disc, graded=True, fine_zone_contact_radii=float(k))
     return replace(base, discretisation=disc).with_sized_domain()
 
 
@@ -54,7 +63,9 @@ def run_one(scene: Scene, threads: int) -> dict:
     return row
 
 
-def label(k: float | None) -> str:
+def label(k: float | str | None) -> str:
+    if k == "paper":
+        return "paper's settings"
     return "uniform" if k is None else f"graded k={k:g}"
 
 
@@ -84,6 +95,8 @@ def main() -> None:
     parser.add_argument("--scenes", nargs="+", choices=list(SCENES), default=list(SCENES))
     parser.add_argument("--k", nargs="+", type=float, default=[1.5, 1.0], help="fine-zone sizes, contact radii")
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--sizes", nargs="+", type=float, default=None, help="particle sizes, um")
+    parser.add_argument("--paper", action="store_true", help="also the paper's numerical setup")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "graded_particles.json")
     args = parser.parse_args()
 
@@ -91,9 +104,9 @@ def main() -> None:
     for name in args.scenes:
         example, sizes = SCENES[name]
         runs[name] = {}
-        for h in sizes:
+        for h in args.sizes or sizes:
             runs[name][str(h)] = {}
-            for k in [None, *args.k]:
+            for k in [None, *args.k, *(["paper"] if args.paper else [])]:
                 row = run_one(scene_at(example, h, k), args.threads)
                 runs[name][str(h)][label(k)] = row
                 print(f"{name} h = {h} um {label(k)}: {row['particles']:,} particles, {row['wall_s']:.1f} s, "
