@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
@@ -72,5 +73,76 @@ def test_coarse_particles_are_sampled_on_the_fine_columns():
     sx, sy, top, index = surface_samples(SimpleNamespace(x=x, vol0=vol0, J=J, n=2), h)
     assert sx.size == 5 and list(index) == [0, 1, 1, 1, 1]
     np.testing.assert_allclose(top, [0.0] + [-h + h * 1.1] * 4, atol=1e-18)
-    np.testing.assert_allclose(sorted(sx[1:]), [3 * h - 0.55 * h] * 2 + [3 * h + 0.55 * h] * 2)
-    np.testing.assert_allclose(sorted(sy[1:]), [3 * h - 0.55 * h] * 2 + [3 * h + 0.55 * h] * 2)
+    corners = {(3 * h + a * 0.55 * h, 3 * h + b * 0.55 * h) for a in (-1, 1) for b in (-1, 1)}
+    got = set(zip(sx[1:], sy[1:], strict=True))
+    assert len(got) == 4
+    for c in corners:  # every quarter-point column once
+        assert min(math.hypot(c[0] - g[0], c[1] - g[1]) for g in got) < 1e-18
+
+
+@pytest.mark.parametrize("shift_h", [0.0, 0.5, 1.0, 1.5])  # the middle section at either parity of the 2 h rows
+def test_graded_block_gives_the_lattice_surface_and_sections(shift_h):
+    """An undeformed graded block: the same flat residual profile and height map as the uniform
+    lattice (no bin left empty by the 2 h particles), and the middle section holds far-field particles."""
+    from plough.mpm import solver
+    from plough.mpm.io import picture_variables
+
+    base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml").with_sized_domain()
+    a = 50e-6
+    x_end = base.start_x_m + base.sliding.distance_m + shift_h * base.discretisation.particle_size_m
+    out = {}
+    for graded in (False, True):
+        s = replace(base, discretisation=replace(base.discretisation, graded=graded, fine_zone_contact_radii=0.5))
+        p = solver.init(s, n_chunks=1)[0].particles
+        y, z, sections = residual_profiles(p, s, x_end, a)
+        variables, _ = picture_variables(p, s, np.array([x_end, 0.0, 0.0]), 0, a, sections)
+        out[graded] = (p, y, z, variables)
+    p_g, y_g, z_g, v_g = out[True]
+    _, y_u, z_u, v_u = out[False]
+    assert np.any(np.isclose(p_g.vol0, 8 * p_g.vol0.min()))  # the far field is coarse
+    np.testing.assert_array_equal(y_g, y_u)
+    np.testing.assert_allclose(z_u, 0.0, atol=1e-18)
+    np.testing.assert_allclose(z_g, 0.0, atol=1e-18)  # every bin sampled, flat
+    hmap_u, hmap_g = v_u["height_map"][1], v_g["height_map"][1]
+    assert np.isfinite(hmap_u).all() and np.isfinite(hmap_g).all()
+    np.testing.assert_allclose(hmap_g, 0.0, atol=1e-18)
+    # the middle section outside the fine zone: one row of h particles, or one row of 2 h particles
+    # holding a quarter as many per area (plus the unmerged h particles along the curved boundary)
+    h = base.discretisation.particle_size_m
+    w = 0.5 * base.expected_contact()[0]
+
+    def far_count(v):
+        sy, sz = v["section_y"][1], v["section_z"][1]
+        return int(((sy > w + h) | (sz < -w - h)).sum())
+
+    assert far_count(v_u) > 100
+    assert far_count(v_g) >= 0.25 * far_count(v_u)
+
+
+def test_snapshot_is_vtk_polydata_with_the_particle_fields(tmp_path):
+    """Decode the .vtp: every point array has one value per particle; positions and sizes round-trip."""
+    import base64
+    import xml.etree.ElementTree as ET
+
+    from plough.mpm import solver
+    from plough.mpm.io import write_snapshot
+
+    scene = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml").with_sized_domain()
+    scene = replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_contact_radii=0.5))
+    p = solver.init(scene, n_chunks=1)[0].particles
+    path = write_snapshot(p, tmp_path / "s.vtp", np.array([0.0, 0.0, 1e-4]), 1e-4, coating_row=0)
+    piece = ET.parse(path).getroot().find("PolyData/Piece")
+    assert int(piece.get("NumberOfPoints")) == p.n
+
+    def decode(el):
+        # the 4-byte length header is its own base64 block of 8 characters, then the data
+        nbytes = int(np.frombuffer(base64.b64decode(el.text[:8]), np.uint32)[0])
+        body = base64.b64decode(el.text[8:])
+        assert len(body) == nbytes
+        return np.frombuffer(body, np.float32).reshape(p.n, int(el.get("NumberOfComponents")))
+
+    arrays = {el.get("Name"): decode(el) for el in piece.find("PointData")}
+    assert {"material", "coating_fraction", "plastic_strain", "stress_Pa", "size_m"} <= set(arrays)
+    np.testing.assert_allclose(decode(piece.find("Points/DataArray")), p.x, rtol=1e-6)
+    h = scene.discretisation.particle_size_m
+    np.testing.assert_allclose(np.unique(np.round(arrays["size_m"][:, 0] / h, 5)), [1.0, 2.0])

@@ -169,7 +169,7 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
 
     mid = (np.abs(y) < h) & (np.abs(x - sphere_centre[0]) < 4.0 * contact_radius) & (z > -3.0 * contact_radius)
     xs_mid = sections[len(sections) // 2]
-    sec = np.abs(x - xs_mid) < 0.5 * h
+    sec = np.abs(x - xs_mid) < 0.5 * np.cbrt(p.vol0)  # one particle row thick: 2 h where graded
     f32 = np.float32
     variables = {
         "height_map": (("hx", "hy"), hmap.astype(f32), {"units": "m", "long_name": "residual top-surface height",
@@ -303,7 +303,7 @@ def _data_array(name: str, arr: np.ndarray, ncomp: int) -> str:
 
 def write_snapshot(p: Particles, path: str | Path, sphere_centre: np.ndarray, sphere_radius: float,
                    coating_row: int = -1) -> Path:
-    """Particles as VTK XML PolyData (.vtp): position, material, plastic strain, temperature, stress."""
+    """Particles as VTK XML PolyData (.vtp): position, material, plastic strain, temperature, stress, size."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     n = p.n
@@ -327,6 +327,7 @@ def write_snapshot(p: Particles, path: str | Path, sphere_centre: np.ndarray, sp
         _data_array("pressure_Pa", pressure, 1),
         _data_array("stress_Pa", sig, 6),
         _data_array("velocity_m_s", p.v, 3),
+        _data_array("size_m", np.cbrt(p.vol0 * p.J), 1),  # current cube edge: h, or 2 h where graded
         "</PointData>",
         "<Points>", _data_array("Points", p.x, 3), "</Points>",
         "<Verts>",

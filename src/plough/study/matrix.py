@@ -246,7 +246,7 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
                                       cfl=float(numerics["cfl"]), mass_scaling=float(numerics["mass_scaling"]),
                                       flip=float(numerics.get("flip", 1.0)),
                                       dilatation=str(numerics.get("dilatation", "projected")),
-                                      graded=bool(numerics.get("graded", False)),
+                                      graded=numerics.get("graded", False),
                                       fine_zone_contact_radii=float(numerics.get("fine_zone_contact_radii", 1.5))),
         outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
                         records=int(numerics["records"]),
