@@ -92,7 +92,7 @@ def test_graded_block_gives_the_lattice_surface_and_sections(shift_h):
     x_end = base.start_x_m + base.sliding.distance_m + shift_h * base.discretisation.particle_size_m
     out = {}
     for graded in (False, True):
-        s = replace(base, discretisation=replace(base.discretisation, graded=graded, fine_zone_contact_radii=0.5))
+        s = replace(base, discretisation=replace(base.discretisation, graded=graded, fine_zone_contact_radii=1.0))
         p = solver.init(s, n_chunks=1)[0].particles
         y, z, sections = residual_profiles(p, s, x_end, a)
         variables, _ = picture_variables(p, s, np.array([x_end, 0.0, 0.0]), 0, a, sections)
@@ -109,7 +109,7 @@ def test_graded_block_gives_the_lattice_surface_and_sections(shift_h):
     # the middle section outside the fine zone: one row of h particles, or one row of 2 h particles
     # holding a quarter as many per area (plus the unmerged h particles along the curved boundary)
     h = base.discretisation.particle_size_m
-    w = 0.5 * base.expected_contact()[0]
+    w = base.expected_contact()[0]
 
     def far_count(v):
         sy, sz = v["section_y"][1], v["section_z"][1]
@@ -128,7 +128,7 @@ def test_snapshot_is_vtk_polydata_with_the_particle_fields(tmp_path):
     from plough.mpm.io import write_snapshot
 
     scene = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml").with_sized_domain()
-    scene = replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_contact_radii=0.5))
+    scene = replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_contact_radii=1.0))
     p = solver.init(scene, n_chunks=1)[0].particles
     path = write_snapshot(p, tmp_path / "s.vtp", np.array([0.0, 0.0, 1e-4]), 1e-4, coating_row=0)
     piece = ET.parse(path).getroot().find("PolyData/Piece")

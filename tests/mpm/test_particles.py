@@ -69,7 +69,7 @@ def test_fine_zone_is_untouched_and_merged_particles_are_double_size(pair):
 
 def test_coarse_particles_straddling_the_coating_carry_its_volume_fraction():
     """t = 15 um at h = 10 um: a 2 h particle spanning -20..0 um is 3/4 coating, -40..-20 um is pure substrate."""
-    scene = graded(coated_scene(t_um=15.0), k=0.5)
+    scene = graded(coated_scene(t_um=15.0), k=1.0)
     state, _ = solver.init(scene, n_chunks=1)
     p = state.particles
     h = 10e-6
@@ -98,8 +98,9 @@ def test_graded_needs_two_particles_per_cell():
     scene = coated_scene()
     with pytest.raises(ValueError, match="particles_per_cell"):
         replace(scene.discretisation, graded=True, particles_per_cell=1)
-    with pytest.raises(ValueError, match="fine_zone_contact_radii"):
-        replace(scene.discretisation, fine_zone_contact_radii=0.0)
+    for k in (0.0, 0.5, float("nan")):
+        with pytest.raises(ValueError, match=r"fine_zone_contact_radii = .* outside the allowed range \[1, inf\)"):
+            replace(scene.discretisation, fine_zone_contact_radii=k)
     with pytest.raises(ValueError, match="graded"):
         replace(scene.discretisation, graded="yes")
 

@@ -204,6 +204,9 @@ class Sliding:
             raise ValueError(f"sliding.press_speed_fraction = {self.press_speed_fraction!r} is outside (0, 1]")
 
 
+#: smallest fine zone of graded particles, in expected contact radii: the sphere touches only h particles
+FINE_ZONE_MIN_CONTACT_RADII = 1.0
+
 #: how J and the pressure see the dilatation rate (see Discretisation)
 DILATATION_MODES = ("projected", "local")
 
@@ -226,7 +229,7 @@ class Discretisation:
     3.69 um against 4.07 / 12.99 um projected (README, "Volumetric locking").
 
     ``graded``: particles of size h only in the *fine zone* along the track (|y| and depth within
-    ``fine_zone_contact_radii`` expected contact radii, over the block's whole length); outside it
+    ``fine_zone_contact_radii`` (>= 1) expected contact radii, over the block's whole length); outside it
     each complete 2 x 2 x 2 group of lattice particles is one particle of size 2 h (one per cell
     at two particles per cell). The grid stays uniform. Off by default (README, "Graded particles").
     """
@@ -255,7 +258,11 @@ class Discretisation:
             raise ValueError(f"discretisation.dilatation = {self.dilatation!r} is not one of {list(DILATATION_MODES)}")
         if not isinstance(self.graded, bool):
             raise ValueError(f"discretisation.graded = {self.graded!r} must be true or false")
-        _finite_positive("discretisation", "fine_zone_contact_radii", self.fine_zone_contact_radii, "")
+        k = self.fine_zone_contact_radii
+        if not (isinstance(k, int | float) and math.isfinite(k) and k >= FINE_ZONE_MIN_CONTACT_RADII):
+            raise ValueError(f"discretisation.fine_zone_contact_radii = {k!r} is outside the allowed range "
+                             f"[{FINE_ZONE_MIN_CONTACT_RADII:g}, inf): the contact (one expected contact radius) "
+                             "must lie in the fine zone")
         if self.graded and self.particles_per_cell < 2:
             raise ValueError("discretisation.graded = true needs discretisation.particles_per_cell >= 2 (got "
                              f"{self.particles_per_cell}): the far-field particles of size 2 h must not exceed a cell")
