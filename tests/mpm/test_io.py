@@ -109,7 +109,7 @@ def test_graded_block_gives_the_lattice_surface_and_sections(shift_h):
     # the middle section outside the fine zone: one row of h particles, or one row of 2 h particles
     # holding a quarter as many per area (plus the unmerged h particles along the curved boundary)
     h = base.discretisation.particle_size_m
-    w = base.expected_contact()[0]
+    w = max(base.expected_contact()[0], 6 * h)
 
     def far_count(v):
         sy, sz = v["section_y"][1], v["section_z"][1]

@@ -49,7 +49,7 @@ def test_fine_zone_is_untouched_and_merged_particles_are_double_size(pair):
     scene, u, g = pair
     h = scene.discretisation.particle_size_m
     a, _ = scene.expected_contact()
-    w = scene.discretisation.fine_zone_contact_radii * a
+    w = max(scene.discretisation.fine_zone_contact_radii * a, 6 * h)
     in_zone_u = (np.abs(u.x[:, 1]) - 0.5 * h <= w) & (u.x[:, 2] + 0.5 * h >= -w)
     fine = np.isclose(g.vol0, h**3, rtol=1e-12, atol=0)
     coarse = np.isclose(g.vol0, 8 * h**3, rtol=1e-12, atol=0)

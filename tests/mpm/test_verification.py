@@ -5,6 +5,7 @@ Slow runs (a few seconds to ~20 s each); the numbers they check are reported in 
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 import numpy as np
@@ -78,27 +79,36 @@ def test_projected_dilatation_removes_volumetric_locking_in_hertz_contact():
     assert abs(projected) < 0.1
 
 
-def tiny_sliding_scene(symmetric: bool) -> Scene:
+def tiny_sliding_scene(symmetric: bool, graded: bool = False) -> Scene:
     return Scene.from_dict({
         "name": "sym", "load_N": 1.0, "sphere": {"radius_um": 200},
         "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
         "interface": {"model": "proportional", "f": 1.0},
-        "domain": {"radius_um": 80, "length_um": 400, "symmetric": symmetric},
+        # graded: a wider block, so that 2 h particles exist outside the 6 h fine zone
+        "domain": {"radius_um": 110 if graded else 80, "length_um": 400, "symmetric": symmetric},
         "sliding": {"distance_um": 200, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
-        "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
+        "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6,
+                           "graded": graded, "fine_zone_contact_radii": 1.0},
         "outputs": {"steady_window": [0.5, 1.0], "records": 40},
     })
 
 
-@pytest.fixture(scope="module")
-def half_and_full():
-    return (simulate(tiny_sliding_scene(True), progress=False),
-            simulate(tiny_sliding_scene(False), progress=False))
+@pytest.fixture(scope="module", params=[False, True], ids=["uniform", "graded"])
+def half_and_full(request):
+    """Half (mirror plane) and full domain of the tiny scene, with uniform or graded particles (the
+    2 h particles lie on one side of y = 0, so the mirror fold stays exact)."""
+    return (simulate(tiny_sliding_scene(True, request.param), progress=False),
+            simulate(tiny_sliding_scene(False, request.param), progress=False))
 
 
 def test_mirror_symmetry_half_and_full_domain_agree(half_and_full):
     half, full = half_and_full
     assert full.attrs["cost_particles"] == 2 * half.attrs["cost_particles"]
+    if json.loads(half.attrs["scene"])["discretisation"]["graded"]:  # the far field is coarse
+        scene = tiny_sliding_scene(True, True)
+        uniform_scene = replace(scene, discretisation=replace(scene.discretisation, graded=False))
+        uniform = solver.init(uniform_scene, n_chunks=1)[0].particles.n
+        assert half.attrs["cost_particles"] < 0.8 * uniform
     assert float(half.mu) == pytest.approx(float(full.mu), rel=0.01)
     assert float(half.dp) == pytest.approx(float(full.dp), rel=0.01)
     # the full body carries no net lateral force

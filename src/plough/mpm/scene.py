@@ -229,7 +229,8 @@ class Discretisation:
     3.69 um against 4.07 / 12.99 um projected (README, "Volumetric locking").
 
     ``graded``: particles of size h only in the *fine zone* along the track (|y| and depth within
-    ``fine_zone_contact_radii`` (>= 1) expected contact radii, over the block's whole length); outside it
+    ``fine_zone_contact_radii`` (>= 1) expected contact radii and at least 6 h, over the block's whole
+    length); outside it
     each complete 2 x 2 x 2 group of lattice particles is one particle of size 2 h (one per cell
     at two particles per cell). The grid stays uniform. Off by default (README, "Graded particles").
     """
