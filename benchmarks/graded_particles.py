@@ -17,7 +17,9 @@ shorter wall time. Scenes:
 
 ``--paper`` adds the paper's numerical setup (``Scene.with_paper_settings()``: its fixed block,
 uniform particles) at each size, for the speed-up of the defaults against it at equal error.
-``--sizes`` replaces the scenes' two sizes.
+``--sizes`` replaces the scenes' two sizes; ``--skip-uniform`` runs the graded cases only (the
+uncoated reference at h = 2.5 um: ``--scenes uncoated --sizes 2.5 --k 1.5 --skip-uniform --out
+benchmarks/results/graded_uncoated_h2.5.json``).
 
 Writes benchmarks/results/graded_particles.json (or ``--out``) after every run (a stopped invocation keeps what
 it measured) and prints a Markdown table.
@@ -37,7 +39,7 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENES = {"coated": ("coated_rigid_plastic.yaml", (10.0, 5.0)),
           "uncoated": ("uncoated_rigid_plastic.yaml", (10.0, 5.0)),
           "real": ("zinc_coated_steel.yaml", (20.0, 10.0))}
-QUANTITIES = ("mu", "mu_pl", "mu_sh", "dp", "Fz_mean")
+QUANTITIES = ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration", "Fz_mean")
 
 
 def scene_at(example: str, h_um: float, k: float | str | None) -> Scene:
@@ -97,6 +99,7 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--sizes", nargs="+", type=float, default=None, help="particle sizes, um")
     parser.add_argument("--paper", action="store_true", help="also the paper's numerical setup")
+    parser.add_argument("--skip-uniform", action="store_true", help="graded runs only (e.g. at h = 2.5 um)")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "graded_particles.json")
     args = parser.parse_args()
 
@@ -106,7 +109,7 @@ def main() -> None:
         runs[name] = {}
         for h in args.sizes or sizes:
             runs[name][str(h)] = {}
-            for k in [None, *args.k, *(["paper"] if args.paper else [])]:
+            for k in [*([] if args.skip_uniform else [None]), *args.k, *(["paper"] if args.paper else [])]:
                 row = run_one(scene_at(example, h, k), args.threads)
                 runs[name][str(h)][label(k)] = row
                 print(f"{name} h = {h} um {label(k)}: {row['particles']:,} particles, {row['wall_s']:.1f} s, "
