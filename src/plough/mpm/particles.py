@@ -104,8 +104,8 @@ def _lattice(scene: Scene, nx: int) -> np.ndarray:
     return x
 
 
-#: the fine zone is never narrower than this many particle sizes h: on a 1 N scene whose contact is
-#: 2.7 h wide (tests/mpm/test_verification.py's tiny scene at h = 10 um) a 4 h zone moved dp +63%
+#: the fine zone is never narrower than this many particle sizes h: on a 1 N scene whose expected
+#: contact radius is 2.7 h (tests/mpm/test_verification.py's tiny scene at h = 10 um) a 4 h zone moved dp +63%
 #: (1.45 -> 2.36 um), a 5.3 h zone +2.7%
 FINE_ZONE_MIN_PARTICLES = 6.0
 
