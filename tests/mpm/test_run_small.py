@@ -169,6 +169,8 @@ def test_check_stability_names_step_sliding_distance_and_cause(tiny_state, code)
     msg = str(err.value)
     assert "step 1234" in msg and "sliding distance 123.4 um" in msg
     assert solver.CAUSES[code] in msg
+    x = state.particles.x[77] * 1e6  # the offending particle (chunk 1's index) is located
+    assert f"particle 77 at ({x[0]:.1f}, {x[1]:.1f}, {x[2]:.1f}) um" in msg and "grid interior" in msg
     # all clear: no error
     state.work.acc[:] = 0.0
     solver.check_stability(state, const)

@@ -317,10 +317,26 @@ def check_stability(s: State, c: Constants) -> None:
     bad = int(acc[:, transfers.ACC_BAD].max())
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
     if bad != transfers.BAD_NONE:
-        raise SimulationError(f"unstable run {where}: {CAUSES[bad]}")
+        chunk = int(np.argmax(acc[:, transfers.ACC_BAD]))
+        raise SimulationError(f"unstable run {where}: {CAUSES[bad]}"
+                              f"{_particle_report(s, c, int(acc[chunk, transfers.ACC_BAD_INDEX]))}")
     kinetic = float(acc[:, transfers.ACC_KINETIC].sum())
     budget = 2.0 * abs(s.work.external_work) + c.load_N * c.grid.dx
     if kinetic > budget:
         raise SimulationError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
                               f"by the sphere ({s.work.external_work:.3g} J): inertia dominates; lower "
                               "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")
+
+
+def _particle_report(s: State, c: Constants, index: int) -> str:
+    """Where the offending particle is, relative to the sphere and the grid, to tell the causes apart."""
+    if index < 0:
+        return ""
+    x = s.particles.x[index]
+    rel = (x - s.sphere.centre) * 1e6
+    lo, hi = c.grid_lo, c.grid_hi
+    return (f" [particle {index} at ({x[0] * 1e6:.1f}, {x[1] * 1e6:.1f}, {x[2] * 1e6:.1f}) um, "
+            f"({rel[0]:.1f}, {rel[1]:.1f}, {rel[2]:.1f}) um from the sphere centre, initial height "
+            f"{s.particles.z0[index] * 1e6:.1f} um, plastic strain {s.particles.eps_p[index]:.3g}; grid interior "
+            f"x {lo[0] * 1e6:.1f}..{hi[0] * 1e6:.1f}, y {lo[1] * 1e6:.1f}..{hi[1] * 1e6:.1f}, "
+            f"z {lo[2] * 1e6:.1f}..{hi[2] * 1e6:.1f} um]")
