@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -15,3 +16,20 @@ def coated_reference(h_um: float) -> Scene:
     ``h_um`` on the block sized from the expected contact."""
     base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml")
     return replace(base, discretisation=replace(base.discretisation, particle_size_m=h_um * 1e-6)).with_sized_domain()
+
+
+#: the steady-state results a benchmark row keeps of a run
+RESULTS = ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration", "Fz_mean")
+
+
+def run_scene(scene: Scene, threads: int) -> dict:
+    """Simulate ``scene`` and return its steady-state results with the run's cost and provenance."""
+    from plough.mpm.run import simulate
+
+    t0 = time.perf_counter()
+    ds = simulate(scene, progress=False, threads=threads)
+    row = {q: float(ds[q]) for q in RESULTS}
+    row.update(git_commit=str(ds.attrs.get("git_commit", "unknown")),
+               wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
+               steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]))
+    return row

@@ -29,9 +29,10 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 from dataclasses import replace
 from pathlib import Path
+
+from common import run_scene
 
 from plough.mpm.scene import Scene
 
@@ -39,7 +40,6 @@ ROOT = Path(__file__).resolve().parents[1]
 SCENES = {"coated": ("coated_rigid_plastic.yaml", (10.0, 5.0)),
           "uncoated": ("uncoated_rigid_plastic.yaml", (10.0, 5.0)),
           "real": ("zinc_coated_steel.yaml", (20.0, 10.0))}
-QUANTITIES = ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration", "Fz_mean")
 
 
 def scene_at(example: str, h_um: float, k: float | str | None) -> Scene:
@@ -51,18 +51,6 @@ def scene_at(example: str, h_um: float, k: float | str | None) -> Scene:
     if k is not None:
         disc = replace(disc, graded=True, fine_zone_contact_radii=float(k))
     return replace(base, discretisation=disc).with_sized_domain()
-
-
-def run_one(scene: Scene, threads: int) -> dict:
-    from plough.mpm.run import simulate
-
-    t0 = time.perf_counter()
-    ds = simulate(scene, progress=False, threads=threads)
-    row = {q: float(ds[q]) for q in QUANTITIES}
-    row.update(wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
-               particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]),
-               git_commit=str(ds.attrs.get("git_commit", "unknown")))
-    return row
 
 
 def label(k: float | str | None) -> str:
@@ -110,7 +98,7 @@ def main() -> None:
         for h in args.sizes or sizes:
             runs[name][str(h)] = {}
             for k in [*([] if args.skip_uniform else [None]), *args.k, *(["paper"] if args.paper else [])]:
-                row = run_one(scene_at(example, h, k), args.threads)
+                row = run_scene(scene_at(example, h, k), args.threads)
                 runs[name][str(h)][label(k)] = row
                 print(f"{name} h = {h} um {label(k)}: {row['particles']:,} particles, {row['wall_s']:.1f} s, "
                       f"mu {row['mu']:.4f}, mu_sh {row['mu_sh']:.4f}, dp {row['dp'] * 1e6:.2f} um", flush=True)

@@ -32,6 +32,8 @@ import tempfile
 from datetime import date
 from pathlib import Path
 
+from plough.io import git_commit
+
 ROOT = Path(__file__).resolve().parents[1]
 PEER_DIR = ROOT.parent / "shared" / "peer-bench"
 
@@ -53,14 +55,6 @@ def run_plough(threads: int, steps: int, h_um: float) -> dict:
                "--steps", str(steps), "--threads", str(threads), "--out", str(out)]
         subprocess.run(cmd, check=True, capture_output=True, text=True)
         return json.loads(out.read_text())
-
-
-def git_commit() -> str:
-    try:
-        return subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True,
-                              check=True).stdout.strip()
-    except (OSError, subprocess.CalledProcessError):
-        return "unknown"
 
 
 def main() -> None:

@@ -29,12 +29,12 @@ from __future__ import annotations
 
 import argparse
 import json
-import time
 from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
+from common import run_scene
 
 from plough.mpm.scene import Scene
 
@@ -84,15 +84,8 @@ def at_size(scene: Scene, h_um: float) -> Scene:
 
 
 def run_one(scene: Scene, threads: int) -> dict[str, float]:
-    from plough.mpm.run import simulate
-
-    t0 = time.perf_counter()
-    ds = simulate(scene, progress=False, threads=threads)
-    row = {k: float(ds[k]) for k in ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")}
-    row.update(git_commit=str(ds.attrs.get("git_commit", "unknown")),
-               wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
-               steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]),
-               h_um=scene.discretisation.particle_size_m * 1e6, inertia_number=scene.inertia_number,
+    row = run_scene(scene, threads)
+    row.update(h_um=scene.discretisation.particle_size_m * 1e6, inertia_number=scene.inertia_number,
                load_N=scene.load_N)
     return row
 
