@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+from dataclasses import replace
 
 import numba
 import numpy as np
@@ -174,6 +175,31 @@ def test_check_stability_names_step_sliding_distance_and_cause(tiny_state, code)
     # all clear: no error
     state.work.acc[:] = 0.0
     solver.check_stability(state, const)
+
+
+def test_a_particle_above_the_grid_top_is_named_a_prow_and_points_at_the_headroom(tiny_state):
+    state, const = tiny_state
+    state.work.acc[:] = 0.0
+    state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
+    state.work.acc[0, transfers.ACC_BAD_INDEX] = 5
+    state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * const.grid.dx
+    with pytest.raises(solver.SimulationError, match=r"rose above the grid's top.*domain\.headroom_m"):
+        solver.check_stability(state, const)
+    state.particles.x[5, 2] = 0.0  # left through a side: the general cause
+    with pytest.raises(solver.SimulationError) as err:
+        solver.check_stability(state, const)
+    assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "headroom" not in str(err.value)
+
+
+def test_grid_top_follows_the_headroom(tiny_scene):
+    """Material may rise to the grid interior's top: the headroom plus the padding (2 to 3 cells)."""
+    for headroom in (None, 3.0 * tiny_scene.grid_headroom_m):
+        scene = tiny_scene.with_(domain=replace(tiny_scene.domain, headroom_m=headroom))
+        _, const = solver.init(scene, n_chunks=1)
+        top, dx = const.grid_hi[2], const.grid.dx
+        assert scene.grid_headroom_m + 2 * dx <= top + 1e-12 < scene.grid_headroom_m + 3 * dx
+    a, dp = tiny_scene.expected_contact()
+    assert tiny_scene.grid_headroom_m >= scene_module.HEADROOM_CONTACT_RADII * a + 0.5 * dp
 
 
 def test_check_stability_flags_runaway_kinetic_energy(tiny_state):

@@ -18,6 +18,7 @@ import yaml
 
 from plough.materials import DX56, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
 from plough.mpm import contact, io, solver
+from plough.mpm import scene as scene_module
 from plough.mpm.constitutive import I_RHO
 from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
 
@@ -390,3 +391,23 @@ def test_paper_preset_sets_the_papers_numerics_and_keeps_the_physics():
     assert apply_preset(s, "sized").domain == s.with_sized_domain().domain
     with pytest.raises(ValueError, match="preset = 'fast' is unknown"):
         apply_preset(s, "fast")
+
+
+def test_headroom_is_validated_round_trips_and_survives_the_presets():
+    s = Scene.from_yaml(Path(__file__).resolve().parents[2] / "examples" / "coated_rigid_plastic.yaml")
+    auto = s.grid_headroom_m
+    a, dp = s.expected_contact()
+    assert auto == pytest.approx(max(2 * dp, 2 * s.discretisation.cell_size_m, scene_module.HEADROOM_CONTACT_RADII * a)
+                                 + 0.5 * dp, rel=1e-12)
+    d = s.to_dict()
+    assert d["domain"]["headroom_m"] is None
+    del d["domain"]["headroom_m"]
+    d["domain"]["headroom_um"] = 150
+    tall = Scene.from_dict(d)
+    assert tall.domain.headroom_m == pytest.approx(150e-6) and tall.grid_headroom_m == pytest.approx(150e-6)
+    assert Scene.from_yaml(tall.to_yaml()) == tall
+    assert tall.with_sized_domain().domain.headroom_m == tall.domain.headroom_m
+    assert tall.with_paper_settings().domain.headroom_m == tall.domain.headroom_m
+    for bad in (0.0, -1e-6, float("nan")):
+        with pytest.raises(ValueError, match=r"domain\.headroom_m"):
+            Domain(headroom_m=bad)

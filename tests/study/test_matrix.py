@@ -340,3 +340,20 @@ def test_graded_particles_reach_every_scene_of_the_matrix(config):
         disc = Scene.from_dict(d).discretisation
         assert disc.graded is changed["mpm"]["numerics"]["graded"] and disc.fine_zone_contact_radii == 1.25
         assert d != before[rid]  # a changed scene: the workflow reruns it
+
+
+@pytest.mark.parametrize("mode", ["sized", "fixed"])
+def test_grid_headroom_reaches_every_scene_of_the_matrix(config, mode):
+    """numerics.domain.headroom_um is optional (automatic when absent) and, when given, sets every run's headroom."""
+    auto = copy.deepcopy(config)
+    dom = {"mode": "sized", "radius_contact_radii": 2.5, "end_margin_contact_radii": 3.0} if mode == "sized" else \
+        {"mode": "fixed", "radius_um": 2000, "length_um": 6000}
+    auto["mpm"]["numerics"]["domain"] = dom
+    tall = copy.deepcopy(auto)
+    tall["mpm"]["numerics"]["domain"]["headroom_um"] = 120
+    before, after = matrix.all_runs(auto), matrix.all_runs(tall)
+    assert set(before) == set(after)
+    for rid, d in after.items():
+        assert Scene.from_dict(before[rid]).domain.headroom_m is None
+        assert Scene.from_dict(d).domain.headroom_m == pytest.approx(120e-6)
+        assert Scene.from_dict(d).grid_headroom_m == pytest.approx(120e-6)

@@ -142,18 +142,34 @@ class Layers:
 
 @dataclass(frozen=True)
 class Domain:
-    """The simulated block: a half cylinder of radius ``radius_m`` and length ``length_m``."""
+    """The simulated block: a half cylinder of radius ``radius_m`` and length ``length_m``.
+
+    ``headroom_m`` is the height of the grid above the original surface, the room material has to
+    rise into (pile-up, and the prow an adhesive interface pushes up the sphere's front); None
+    sizes it from the expected contact (``Scene.grid_headroom_m``). It costs grid nodes, not
+    particles.
+    """
 
     radius_m: float = 200e-6
     length_m: float = 1000e-6
     symmetric: bool = True
+    headroom_m: float | None = None
 
     def __post_init__(self) -> None:
         _finite_positive("domain", "radius_m", self.radius_m, "m")
         _finite_positive("domain", "length_m", self.length_m, "m")
+        if self.headroom_m is not None:
+            _finite_positive("domain", "headroom_m", self.headroom_m, "m")
         if not isinstance(self.symmetric, bool):
             raise ValueError(f"domain.symmetric = {self.symmetric!r} must be true or false")
 
+
+#: Automatic grid headroom in expected contact radii (``Scene.grid_headroom_m``): at h = 2.5 um the
+#: uncoated reference scene (f = 1, a = 46 um) pushes a prow up the sphere's front that keeps
+#: growing (25 um above the original surface after 0.39 mm of sliding); the earlier rule (2.5 dp,
+#: at least 2 cells + padding: 25 um there) stopped that run. Grid nodes above the material cost
+#: little (no particle maps to them).
+HEADROOM_CONTACT_RADII = 1.0
 
 #: Named numerical presets a scene file can be run with (``plough mpm --preset``,
 #: ``plough.mpm.run.apply_preset``): the paper's setup, or the block sized from the contact.
@@ -387,6 +403,17 @@ class Scene:
 
     # -- derived quantities
     @property
+    def grid_headroom_m(self) -> float:
+        """Height of the grid above the original surface: ``domain.headroom_m``, or sized from the
+        expected contact: room for the pile-up (2.5 dp, at least 2 cells + 0.5 dp) and for the prow
+        an adhesive interface pushes up the sphere's front (``HEADROOM_CONTACT_RADII`` expected
+        contact radii; README, *Status of the MPM solver*)."""
+        if self.domain.headroom_m is not None:
+            return self.domain.headroom_m
+        a, dp = self.expected_contact()
+        return max(2.0 * dp, 2.0 * self.discretisation.cell_size_m, HEADROOM_CONTACT_RADII * a) + 0.5 * dp
+
+    @property
     def inertia_number(self) -> float:
         """ms rho v^2 / H of the softest layer: the dynamic pressure of the slide over the hardness."""
         ms, v = self.discretisation.mass_scaling, self.sliding.speed_m_s
@@ -544,7 +571,7 @@ class Scene:
         dom = sized_domain(self.layers, self.load_N, self.sphere.radius_m, self.sliding.distance_m,
                            self.discretisation.particle_size_m, self.domain.symmetric,
                            radius_contact_radii, end_margin_contact_radii)
-        return replace(self, domain=dom)
+        return replace(self, domain=replace(dom, headroom_m=self.domain.headroom_m))
 
     def with_paper_settings(self) -> Scene:
         """The paper's numerical setup as a named preset: the fixed 0.2 mm x 1 mm half cylinder
@@ -552,7 +579,7 @@ class Scene:
         window the last half of the slide. Physics (layers, load, sphere, interface) and the
         particle size, CFL number and transfer are kept. ``benchmarks/work_precision.py`` runs it
         beside the defaults."""
-        return replace(self, domain=PAPER_DOMAIN,
+        return replace(self, domain=replace(PAPER_DOMAIN, headroom_m=self.domain.headroom_m),
                        sliding=replace(self.sliding, distance_m=600e-6, speed_m_s=0.1, stop_when_steady=False),
                        discretisation=replace(self.discretisation, mass_scaling=1e6, graded=False),
                        outputs=replace(self.outputs, steady_window=(0.5, 1.0)))

@@ -154,9 +154,8 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
 
     disc = scene.discretisation
     dx = disc.cell_size_m
-    a_exp, dp_exp = scene.expected_contact()
-    headroom = max(2.0 * dp_exp, 2.0 * dx) + 0.5 * dp_exp
-    grid = make_grid(scene.domain.length_m, scene.domain.radius_m, scene.domain.symmetric, dx, headroom)
+    a_exp, _ = scene.expected_contact()
+    grid = make_grid(scene.domain.length_m, scene.domain.radius_m, scene.domain.symmetric, dx, scene.grid_headroom_m)
     c = wave_speed(table, disc.mass_scaling)
     v_max = scene.sliding.speed_m_s * 2.0
     dt = disc.cfl * dx / (c + v_max)
@@ -318,8 +317,13 @@ def check_stability(s: State, c: Constants) -> None:
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
     if bad != transfers.BAD_NONE:
         chunk = int(np.argmax(acc[:, transfers.ACC_BAD]))
-        raise SimulationError(f"unstable run {where}: {CAUSES[bad]}"
-                              f"{_particle_report(s, c, int(acc[chunk, transfers.ACC_BAD_INDEX]))}")
+        index = int(acc[chunk, transfers.ACC_BAD_INDEX])
+        cause = CAUSES[bad]
+        if bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]:
+            cause = (f"a particle rose above the grid's top (z = {c.grid_hi[2] * 1e6:.1f} um over the original "
+                     "surface): material pushed up ahead of or beside the sphere (a prow) outgrew the grid's "
+                     "headroom; set domain.headroom_m higher")
+        raise SimulationError(f"unstable run {where}: {cause}{_particle_report(s, c, index)}")
     kinetic = float(acc[:, transfers.ACC_KINETIC].sum())
     budget = 2.0 * abs(s.work.external_work) + c.load_N * c.grid.dx
     if kinetic > budget:

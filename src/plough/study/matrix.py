@@ -16,7 +16,7 @@ rigid-plastic studies, 3 sigma_y at a plastic strain of 0.08 (Tabor) for the rea
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -231,12 +231,14 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
     layers = point.layers()
     dom = numerics["domain"]
     symmetric = bool(numerics.get("symmetric", True))
+    headroom = None if dom.get("headroom_um") is None else float(dom["headroom_um"]) * 1e-6
     if dom["mode"] == "sized":
         domain = sized_domain(layers, point.load_N, point.radius_m, slide, h, symmetric,
                               float(dom["radius_contact_radii"]), float(dom["end_margin_contact_radii"]))
+        domain = replace(domain, headroom_m=headroom)
     else:
         domain = Domain(radius_m=float(dom["radius_um"]) * 1e-6, length_m=float(dom["length_um"]) * 1e-6,
-                         symmetric=symmetric)
+                        symmetric=symmetric, headroom_m=headroom)
     return Scene(
         layers=layers, load_N=point.load_N, sphere=Sphere(radius_m=point.radius_m),
         interface=interface_from_dict(point.interface), domain=domain,
