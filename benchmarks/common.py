@@ -31,5 +31,6 @@ def run_scene(scene: Scene, threads: int) -> dict:
     row = {q: float(ds[q]) for q in RESULTS}
     row.update(git_commit=str(ds.attrs.get("git_commit", "unknown")),
                wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
-               steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]))
+               steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]),
+               material_top_max_m=float(ds.material_top.max()), grid_nodes=int(ds.attrs["cost_grid_nodes"]))
     return row

@@ -130,6 +130,19 @@ def test_no_particle_enters_the_sphere(tiny_run, tiny_scene):
     assert np.all(tiny_run.particle_penetration.values < 0.5 * h)
 
 
+def test_material_top_bounds_the_residual_surface(tiny_run, tiny_scene):
+    """The highest particle centre, recorded over the run, lies above the residual profile's top face
+    minus half a particle, and starts at the undeformed top layer's centre (-h/2)."""
+    h = tiny_scene.discretisation.particle_size_m
+    top = tiny_run.material_top.values
+    assert top[0] >= -0.5 * h - 1e-12 and np.all(np.isfinite(top))
+    profile_top = float(np.nanmax(tiny_run.profile_z.values))
+    assert profile_top - 0.5 * h <= top[-1] + 1e-12
+    assert top.max() > -0.5 * h + 1e-9  # the pile-up lifted some particle
+    _, const = solver.init(tiny_scene, n_chunks=1)
+    assert top.max() < const.grid_hi[2]
+
+
 def test_units_and_long_names(tiny_run):
     for name, var in tiny_run.variables.items():
         assert "units" in var.attrs, name

@@ -51,6 +51,7 @@ class _Recorder:
             "Fx": m[0], "Fy": m[1], "Fz": m[2], "Fx_pl": m[3], "Fx_sh": m[4], "Fz_pl": m[5], "Fz_sh": m[6],
             "depth": c.sphere_radius - s.sphere.centre[2],
             "particle_penetration": pen, "contact_area_xy": k * float(w.contact_out[contact.OUT_AREA_XY]),
+            "material_top": float(s.particles.x[:, 2].max()),
             "external_work": k * w.external_work, "plastic_work": k * w.plastic_work,
             "elastic_energy": k * float(acc[:, transfers.ACC_ELASTIC].sum()),
             "kinetic_energy": k * float(acc[:, transfers.ACC_KINETIC].sum()),
