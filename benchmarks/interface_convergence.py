@@ -1,13 +1,15 @@
 """Convergence in the particle size of the coated scene at interface strengths f = 0 and 0.5.
 
     python benchmarks/interface_convergence.py [--sizes-um 20 10 5] [--f 0 0.5]
+    python benchmarks/interface_convergence.py --f 0.5 --sizes-um 10 5 2.5 --graded
 
 Coated rigid-plastic scene (examples/coated_rigid_plastic.yaml: H~ = 0.5, t = 25 um, r = 0.2 mm,
 3 N; sized block, defaults otherwise, 2 threads) with the interface shear tau = f kappa. At f = 1
 (the scene's own interface, benchmarks/work_precision.py) mu follows the simulated speed
 (README, *Interface shear*); this asks whether the ploughing alone (f = 0) and a slipping interface
 (f = 0.5) converge in h, and to what (extrapolated to h -> 0 with plough.study's Richardson rule),
-against the analytical model. Writes
+against the analytical model. ``--graded`` runs the workflow's graded particles (fine zone 1.5
+expected contact radii; cases named "... graded"), which make h = 2.5 um affordable. Writes
 benchmarks/results/interface_convergence.json (a case already there is kept).
 """
 
@@ -33,12 +35,17 @@ OUT = ROOT / "benchmarks" / "results" / "interface_convergence.json"
 KEYS = ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")
 
 
+def case_name(f: float, h: float, graded: bool, speed: float = 1.0) -> str:
+    return f"f {f:g} h {h:g}" + ("" if speed == 1.0 else f" speed x{speed:g}") + (" graded" if graded else "")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[20.0, 10.0, 5.0])
     parser.add_argument("--f", type=float, nargs="+", default=[0.0, 0.5])
     parser.add_argument("--inertia-h-um", type=float, default=None,
                         help="also run speed / 2 at this size (issue 3's inertia check against the h change)")
+    parser.add_argument("--graded", action="store_true", help="graded particles (fine zone 1.5 contact radii)")
     args = parser.parse_args()
     numba.set_num_threads(2)
     base = Scene.from_yaml(ROOT / "examples" / "coated_rigid_plastic.yaml")
@@ -54,38 +61,43 @@ def main() -> None:
         if args.inertia_h_um is not None:
             cases.append((args.inertia_h_um, 0.5))
         for h, speed in cases:
-            name = f"f {f:g} h {h:g}" + ("" if speed == 1.0 else f" speed x{speed:g}")
+            name = case_name(f, h, args.graded, speed)
             if name in runs:
                 continue
             scene = replace(coated_reference(h), interface=ProportionalShear(f=f))
+            if args.graded:
+                scene = replace(scene, discretisation=replace(scene.discretisation, graded=True,
+                                                              fine_zone_contact_radii=1.5))
             scene = replace(scene, sliding=replace(scene.sliding, speed_m_s=scene.sliding.speed_m_s * speed))
             ds = simulate(scene, progress=False)
             runs[name] = {k: float(ds[k]) for k in KEYS}
-            runs[name].update(f=f, h_um=h, wall_s=float(ds.attrs["cost_wall_time_s"]),
-                              particles=int(ds.attrs["cost_particles"]), git_commit=str(ds.attrs.get("git_commit")))
+            runs[name].update(f=f, h_um=h, graded=args.graded, wall_s=float(ds.attrs["cost_wall_time_s"]),
+                              particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]),
+                              material_top_max_m=float(ds.material_top.max()),
+                              git_commit=str(ds.attrs.get("git_commit")))
             print(name, json.dumps(runs[name]), flush=True)
             OUT.write_text(json.dumps(data, indent=2) + "\n")
     for f in args.f:
-        sizes = [h for h in args.sizes_um if f"f {f:g} h {h:g}" in runs]
-        slow = runs.get(f"f {f:g} h {args.inertia_h_um:g} speed x0.5") if args.inertia_h_um else None
+        sizes = [h for h in args.sizes_um if case_name(f, h, args.graded) in runs]
+        slow = runs.get(case_name(f, args.inertia_h_um, args.graded, 0.5)) if args.inertia_h_um else None
         if slow is not None:
-            fast = runs[f"f {f:g} h {args.inertia_h_um:g}"]
+            fast = runs[case_name(f, args.inertia_h_um, args.graded)]
             print(f"f = {f:g}, h = {args.inertia_h_um:g} um, speed / 2: mu {slow['mu'] / fast['mu'] - 1:+.1%}, "
                   f"dp {slow['dp'] / fast['dp'] - 1:+.1%}")
         if len(sizes) < 2:
             continue
         ex = {}
         for q in ("mu", "dp"):
-            e = extrapolate(np.array(sizes) * 1e-6, [runs[f"f {f:g} h {h:g}"][q] for h in sizes])
+            e = extrapolate(np.array(sizes) * 1e-6, [runs[case_name(f, h, args.graded)][q] for h in sizes])
             ex[q] = {"value": float(e.value), "uncertainty": float(e.uncertainty), "order": float(e.order),
                      "method": "richardson" if int(e.method) == 0 else "least squares (flagged)"}
             print(f"f = {f:g}: {q} extrapolated to h -> 0: {float(e.value):.4g} +- {float(e.uncertainty):.2g} "
                   f"({ex[q]['method']}, order {float(e.order):.2f})")
-        data[f"extrapolated f {f:g}"] = ex
+        data[f"extrapolated f {f:g}" + (" graded" if args.graded else "")] = ex
     OUT.write_text(json.dumps(data, indent=2) + "\n")
-    print(f"{'case':12s} {'mu':>6s} {'mu_pl':>6s} {'mu_sh':>6s} {'dp um':>6s} {'wall s':>7s}")
+    print(f"{'case':20s} {'mu':>6s} {'mu_pl':>6s} {'mu_sh':>6s} {'dp um':>6s} {'wall s':>7s}")
     for name, r in runs.items():
-        print(f"{name:12s} {r['mu']:6.3f} {r['mu_pl']:6.3f} {r['mu_sh']:6.3f} {r['dp'] * 1e6:6.2f} {r['wall_s']:7.1f}")
+        print(f"{name:20s} {r['mu']:6.3f} {r['mu_pl']:6.3f} {r['mu_sh']:6.3f} {r['dp'] * 1e6:6.2f} {r['wall_s']:7.1f}")
 
 
 if __name__ == "__main__":
