@@ -1,0 +1,96 @@
+"""How high and how far ahead the material the sphere pushes (the prow) grows over the slide.
+
+    python benchmarks/prow_growth.py --h-um 2.5 --headroom-um 80 --out benchmarks/results/prow_uncoated_h2.5.json
+    python benchmarks/prow_growth.py --scene coated --h-um 5 --f 0.5
+
+Runs a reference scene (examples/uncoated_rigid_plastic.yaml or coated_rigid_plastic.yaml, block
+sized from the expected contact, graded particles with fine zone 1.5 contact radii as the workflow
+runs them) and every ``--every`` steps records the highest particle centre above the original
+surface, where it is relative to the sphere centre, and how many particles stand above 5 and
+10 um. An interface as strong as the material (f = 1) can drag a prow up the sphere's front that
+grows without reaching a steady state; a run that stops (a particle leaving the grid) keeps its
+record up to the stop and the solver's message. Writes the JSON after every record.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import time
+from dataclasses import replace
+from pathlib import Path
+
+import numba
+import numpy as np
+
+from plough.io import git_commit
+from plough.materials import ProportionalShear
+from plough.mpm import solver
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+
+ROOT = Path(__file__).resolve().parents[1]
+EXAMPLES = {"uncoated": "uncoated_rigid_plastic.yaml", "coated": "coated_rigid_plastic.yaml"}
+
+
+def prow_record(state: solver.State, const: solver.Constants, t0: float) -> dict:
+    """The highest particle and the prow's size at this step."""
+    x = state.particles.x
+    i = int(np.argmax(x[:, 2]))
+    c = state.sphere.centre
+    return {"step": state.step, "phase": state.sphere.phase, "slid_um": state.sphere.slid_m * 1e6,
+            "top_um": x[i, 2] * 1e6, "top_ahead_of_centre_um": (x[i, 0] - c[0]) * 1e6, "top_y_um": x[i, 1] * 1e6,
+            "particles_above_5um": int((x[:, 2] > 5e-6).sum()), "particles_above_10um": int((x[:, 2] > 10e-6).sum()),
+            "sphere_bottom_um": (c[2] - const.sphere_radius) * 1e6, "grid_interior_top_um": const.grid_hi[2] * 1e6,
+            "grid_interior_end_x_um": const.grid_hi[0] * 1e6, "wall_s": time.perf_counter() - t0}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--scene", choices=sorted(EXAMPLES), default="uncoated")
+    parser.add_argument("--h-um", type=float, default=5.0)
+    parser.add_argument("--f", type=float, default=None, help="interface f (default: the scene's own, 1)")
+    parser.add_argument("--headroom-um", type=float, default=None, help="domain.headroom_m (default: automatic)")
+    parser.add_argument("--uniform", action="store_true", help="uniform particles instead of graded")
+    parser.add_argument("--every", type=int, default=500, help="steps between records")
+    parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=None)
+    args = parser.parse_args()
+    numba.set_num_threads(args.threads)
+    base = Scene.from_yaml(ROOT / "examples" / EXAMPLES[args.scene])
+    disc = replace(base.discretisation, particle_size_m=args.h_um * 1e-6, graded=not args.uniform,
+                   fine_zone_contact_radii=1.5)
+    scene = replace(base, discretisation=disc).with_sized_domain()
+    if args.f is not None:
+        scene = replace(scene, interface=ProportionalShear(f=args.f))
+    if args.headroom_um is not None:
+        scene = replace(scene, domain=replace(scene.domain, headroom_m=args.headroom_um * 1e-6))
+    out = args.out or ROOT / "benchmarks" / "results" / f"prow_{args.scene}_h{args.h_um:g}.json"
+    data = {"scene": scene.to_dict(), "git_commit": git_commit(), "records": [], "outcome": "running"}
+    t0 = time.perf_counter()
+    plain_step = solver.step
+
+    def step_and_record(state: solver.State, const: solver.Constants) -> None:
+        plain_step(state, const)
+        if state.step % args.every == 0:
+            data["records"].append(prow_record(state, const, t0))
+            out.write_text(json.dumps(data, indent=1) + "\n")
+
+    solver.step = step_and_record  # the run loop calls solver.step: the probe sees every step
+    try:
+        ds = simulate(scene, progress=False)
+        data["outcome"] = "completed"
+        data["results"] = {q: float(ds[q]) for q in ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration")}
+    except solver.SimulationError as exc:
+        data["outcome"] = f"stopped: {exc}"
+    finally:
+        solver.step = plain_step
+    out.write_text(json.dumps(data, indent=1) + "\n")
+    last = data["records"][-1] if data["records"] else {}
+    print(data["outcome"][:300])
+    print(f"highest particle at the last record: {last.get('top_um', float('nan')):.1f} um, "
+          f"{last.get('top_ahead_of_centre_um', float('nan')):.1f} um ahead of the sphere centre")
+
+
+if __name__ == "__main__":
+    main()
