@@ -131,16 +131,16 @@ def test_no_particle_enters_the_sphere(tiny_run, tiny_scene):
 
 
 def test_material_top_bounds_the_residual_surface(tiny_run, tiny_scene):
-    """The highest particle centre, recorded over the run, lies above the residual profile's top face
-    minus half a particle, and starts at the undeformed top layer's centre (-h/2)."""
+    """The highest particle centre, recorded over the run, is near the undeformed top layer's centre
+    (-h/2) at the first record, lies above the residual profile's top face minus half a (possibly
+    dilated) particle at the end, and stays below the automatic headroom (room for the pile-up)."""
     h = tiny_scene.discretisation.particle_size_m
     top = tiny_run.material_top.values
-    assert top[0] >= -0.5 * h - 1e-12 and np.all(np.isfinite(top))
+    assert np.all(np.isfinite(top)) and abs(top[0] + 0.5 * h) < 0.1 * h
     profile_top = float(np.nanmax(tiny_run.profile_z.values))
-    assert profile_top - 0.5 * h <= top[-1] + 1e-12
-    assert top.max() > -0.5 * h + 1e-9  # the pile-up lifted some particle
-    _, const = solver.init(tiny_scene, n_chunks=1)
-    assert top.max() < const.grid_hi[2]
+    assert profile_top - 0.5 * h <= top[-1] + 0.05 * h
+    assert top.max() > -0.5 * h + 0.01 * h  # the pile-up lifted some particle
+    assert top.max() < tiny_scene.grid_headroom_m
 
 
 def test_units_and_long_names(tiny_run):
@@ -211,8 +211,6 @@ def test_grid_top_follows_the_headroom(tiny_scene):
         _, const = solver.init(scene, n_chunks=1)
         top, dx = const.grid_hi[2], const.grid.dx
         assert scene.grid_headroom_m + 2 * dx <= top + 1e-12 < scene.grid_headroom_m + 3 * dx
-    a, dp = tiny_scene.expected_contact()
-    assert tiny_scene.grid_headroom_m >= scene_module.HEADROOM_CONTACT_RADII * a + 0.5 * dp
 
 
 def test_check_stability_flags_runaway_kinetic_energy(tiny_state):

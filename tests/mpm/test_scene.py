@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import copy
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +19,6 @@ import yaml
 
 from plough.materials import DX56, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
 from plough.mpm import contact, io, solver
-from plough.mpm import scene as scene_module
 from plough.mpm.constitutive import I_RHO
 from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
 
@@ -395,10 +395,11 @@ def test_paper_preset_sets_the_papers_numerics_and_keeps_the_physics():
 
 def test_headroom_is_validated_round_trips_and_survives_the_presets():
     s = Scene.from_yaml(Path(__file__).resolve().parents[2] / "examples" / "coated_rigid_plastic.yaml")
-    auto = s.grid_headroom_m
-    a, dp = s.expected_contact()
-    assert auto == pytest.approx(max(2 * dp, 2 * s.discretisation.cell_size_m, scene_module.HEADROOM_CONTACT_RADII * a)
-                                 + 0.5 * dp, rel=1e-12)
+    _, dp = s.expected_contact()
+    for h in (10e-6, 2.5e-6):  # two cells set it at h = 10 um, the groove at h = 2.5 um
+        fine = s.with_(discretisation=replace(s.discretisation, particle_size_m=h))
+        assert fine.grid_headroom_m >= 2.5 * dp and fine.grid_headroom_m >= 2 * fine.discretisation.cell_size_m
+    assert fine.grid_headroom_m == pytest.approx(2.5 * dp, rel=1e-12)
     d = s.to_dict()
     assert d["domain"]["headroom_m"] is None
     del d["domain"]["headroom_m"]
