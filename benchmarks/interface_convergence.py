@@ -25,9 +25,11 @@ import numpy as np
 from common import coated_reference
 
 from plough.analytical import ploughing
+from plough.io import git_commit
 from plough.materials import ProportionalShear, representative_hardness
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
+from plough.mpm.solver import SimulationError
 from plough.study.extrapolation import extrapolate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -69,7 +71,13 @@ def main() -> None:
                 scene = replace(scene, discretisation=replace(scene.discretisation, graded=True,
                                                               fine_zone_contact_radii=1.5))
             scene = replace(scene, sliding=replace(scene.sliding, speed_m_s=scene.sliding.speed_m_s * speed))
-            ds = simulate(scene, progress=False)
+            try:
+                ds = simulate(scene, progress=False)
+            except SimulationError as exc:  # a stopped run is a result too: keep its message
+                runs[name] = {"stopped": str(exc), "f": f, "h_um": h, "graded": args.graded, "git_commit": git_commit()}
+                print(name, "stopped:", exc, flush=True)
+                OUT.write_text(json.dumps(data, indent=2) + "\n")
+                continue
             runs[name] = {k: float(ds[k]) for k in KEYS}
             runs[name].update(f=f, h_um=h, graded=args.graded, wall_s=float(ds.attrs["cost_wall_time_s"]),
                               particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]),
@@ -78,7 +86,7 @@ def main() -> None:
             print(name, json.dumps(runs[name]), flush=True)
             OUT.write_text(json.dumps(data, indent=2) + "\n")
     for f in args.f:
-        sizes = [h for h in args.sizes_um if case_name(f, h, args.graded) in runs]
+        sizes = [h for h in args.sizes_um if "mu" in runs.get(case_name(f, h, args.graded), {})]
         slow = runs.get(case_name(f, args.inertia_h_um, args.graded, 0.5)) if args.inertia_h_um else None
         if slow is not None:
             fast = runs[case_name(f, args.inertia_h_um, args.graded)]
@@ -97,6 +105,9 @@ def main() -> None:
     OUT.write_text(json.dumps(data, indent=2) + "\n")
     print(f"{'case':20s} {'mu':>6s} {'mu_pl':>6s} {'mu_sh':>6s} {'dp um':>6s} {'wall s':>7s}")
     for name, r in runs.items():
+        if "stopped" in r:
+            print(f"{name:20s} stopped: {r['stopped'][:120]}")
+            continue
         print(f"{name:20s} {r['mu']:6.3f} {r['mu_pl']:6.3f} {r['mu_sh']:6.3f} {r['dp'] * 1e6:6.2f} {r['wall_s']:7.1f}")
 
 

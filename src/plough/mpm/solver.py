@@ -321,8 +321,8 @@ def check_stability(s: State, c: Constants) -> None:
         cause = CAUSES[bad]
         if bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]:
             cause = (f"a particle rose above the grid's top (z = {c.grid_hi[2] * 1e6:.1f} um over the original "
-                     "surface): material pushed up ahead of or beside the sphere (a prow) outgrew the grid's "
-                     "headroom; set domain.headroom_m higher")
+                     "surface): material the sphere pushes up (a growing prow: set domain.headroom_m higher) or a "
+                     "particle flung off the surface (lower mass_scaling or speed)")
         raise SimulationError(f"unstable run {where}: {cause}{_particle_report(s, c, index)}")
     kinetic = float(acc[:, transfers.ACC_KINETIC].sum())
     budget = 2.0 * abs(s.work.external_work) + c.load_N * c.grid.dx
