@@ -146,7 +146,7 @@ class Domain:
 
     ``headroom_m`` is the height of the grid above the original surface, the room material has to
     rise into (pile-up, and the prow an adhesive interface pushes up the sphere's front); None
-    sizes it from the expected contact (``Scene.grid_headroom_m``). It costs grid nodes, not
+    sizes it from the expected groove (``Scene.grid_headroom_m``). It costs grid nodes, not
     particles.
     """
 
