@@ -22,19 +22,17 @@ from pathlib import Path
 
 import numba
 import numpy as np
-from common import coated_reference
+from common import coated_reference, run_scene
 
 from plough.analytical import ploughing
 from plough.io import git_commit
 from plough.materials import ProportionalShear, representative_hardness
-from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 from plough.mpm.solver import SimulationError
 from plough.study.extrapolation import extrapolate
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "interface_convergence.json"
-KEYS = ("mu", "mu_pl", "mu_sh", "dp", "penetration", "Fz_mean")
 
 
 def case_name(f: float, h: float, graded: bool, speed: float = 1.0) -> str:
@@ -72,17 +70,13 @@ def main() -> None:
                                                               fine_zone_contact_radii=1.5))
             scene = replace(scene, sliding=replace(scene.sliding, speed_m_s=scene.sliding.speed_m_s * speed))
             try:
-                ds = simulate(scene, progress=False)
+                row = run_scene(scene, threads=2)
             except SimulationError as exc:  # a stopped run is a result too: keep its message
                 runs[name] = {"stopped": str(exc), "f": f, "h_um": h, "graded": args.graded, "git_commit": git_commit()}
                 print(name, "stopped:", exc, flush=True)
                 OUT.write_text(json.dumps(data, indent=2) + "\n")
                 continue
-            runs[name] = {k: float(ds[k]) for k in KEYS}
-            runs[name].update(f=f, h_um=h, graded=args.graded, wall_s=float(ds.attrs["cost_wall_time_s"]),
-                              particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]),
-                              material_top_max_m=float(ds.material_top.max()),
-                              git_commit=str(ds.attrs.get("git_commit")))
+            runs[name] = {**row, "f": f, "h_um": h, "graded": args.graded}
             print(name, json.dumps(runs[name]), flush=True)
             OUT.write_text(json.dumps(data, indent=2) + "\n")
     for f in args.f:
