@@ -33,6 +33,10 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = {"uncoated": "uncoated_rigid_plastic.yaml", "coated": "coated_rigid_plastic.yaml"}
 
 
+class ProbeEnd(Exception):
+    """Raised from the probe to end a run early (``--stop-um``); not a solver failure."""
+
+
 def prow_record(state: solver.State, const: solver.Constants, t0: float) -> dict:
     """The highest particle and the prow's size at this step."""
     x = state.particles.x
@@ -52,6 +56,10 @@ def main() -> None:
     parser.add_argument("--f", type=float, default=None, help="interface f (default: the scene's own, 1)")
     parser.add_argument("--headroom-um", type=float, default=None, help="domain.headroom_m (default: automatic)")
     parser.add_argument("--uniform", action="store_true", help="uniform particles instead of graded")
+    parser.add_argument("--cfl", type=float, default=None, help="discretisation.cfl (default: the scene's, 0.3)")
+    parser.add_argument("--flip", type=float, default=None, help="discretisation.flip (default: the scene's, 1)")
+    parser.add_argument("--stop-um", type=float, default=None,
+                        help="end the run after this much sliding (a probe of the prow's early growth)")
     parser.add_argument("--every", type=int, default=500, help="steps between records")
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--out", type=Path, default=None)
@@ -60,6 +68,10 @@ def main() -> None:
     base = Scene.from_yaml(ROOT / "examples" / EXAMPLES[args.scene])
     disc = replace(base.discretisation, particle_size_m=args.h_um * 1e-6, graded=not args.uniform,
                    fine_zone_contact_radii=1.5)
+    if args.cfl is not None:
+        disc = replace(disc, cfl=args.cfl)
+    if args.flip is not None:
+        disc = replace(disc, flip=args.flip)
     scene = replace(base, discretisation=disc).with_sized_domain()
     if args.f is not None:
         scene = replace(scene, interface=ProportionalShear(f=args.f))
@@ -75,6 +87,9 @@ def main() -> None:
         if state.step % args.every == 0:
             data["records"].append(prow_record(state, const, t0))
             out.write_text(json.dumps(data, indent=1) + "\n")
+        if args.stop_um is not None and state.sphere.slid_m * 1e6 >= args.stop_um:
+            data["records"].append(prow_record(state, const, t0))
+            raise ProbeEnd(f"ended by --stop-um after {state.sphere.slid_m * 1e6:.1f} um of sliding")
 
     solver.step = step_and_record  # the run loop calls solver.step: the probe sees every step
     try:
@@ -83,6 +98,8 @@ def main() -> None:
         data["results"] = {q: float(ds[q]) for q in ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration")}
     except solver.SimulationError as exc:
         data["outcome"] = f"stopped: {exc}"
+    except ProbeEnd as exc:
+        data["outcome"] = str(exc)
     finally:
         solver.step = plain_step
     out.write_text(json.dumps(data, indent=1) + "\n")
