@@ -2,6 +2,8 @@
 
     python benchmarks/prow_growth.py --h-um 2.5 --headroom-um 80 --out benchmarks/results/prow_uncoated_h2.5.json
     python benchmarks/prow_growth.py --scene coated --h-um 5 --f 0.5
+    python benchmarks/prow_growth.py --scene coated --f 0.5 --h-um 2.5 --headroom-um 70.6 --flip 0.9 --stop-um 120 \
+        --out benchmarks/results/prow_coated_f0.5_h2.5_flip0.9_to120um.json
 
 Runs a reference scene (examples/uncoated_rigid_plastic.yaml or coated_rigid_plastic.yaml, block
 sized from the expected contact, graded particles with fine zone 1.5 contact radii as the workflow
@@ -9,7 +11,9 @@ runs them) and every ``--every`` steps records the highest particle centre above
 surface, where it is relative to the sphere centre, and how many particles stand above 5 and
 10 um. An interface as strong as the material (f = 1) can drag a prow up the sphere's front that
 grows without reaching a steady state; a run that stops (a particle leaving the grid) keeps its
-record up to the stop and the solver's message. Writes the JSON after every record.
+record up to the stop and the solver's message. ``--cfl``, ``--flip`` and ``--f`` change one knob to
+ask what the growth needs; ``--stop-um`` ends the run early (its outcome says so; no steady-state
+results then). Writes the JSON after every record.
 """
 
 from __future__ import annotations
