@@ -29,7 +29,7 @@ from plough.io import git_commit
 from plough.materials import ProportionalShear, representative_hardness
 from plough.mpm.scene import Scene
 from plough.mpm.solver import SimulationError
-from plough.study.extrapolation import extrapolate
+from plough.study.extrapolation import Method, extrapolate
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "interface_convergence.json"
@@ -98,7 +98,7 @@ def main() -> None:
             values = [runs[case_name(f, h, args.graded, flip=args.flip)][q] for h in sizes]
             e = extrapolate(np.array(sizes) * 1e-6, values)
             ex[q] = {"value": float(e.value), "uncertainty": float(e.uncertainty), "order": float(e.order),
-                     "method": "richardson" if int(e.method) == 0 else "least squares (flagged)"}
+                     "method": Method(int(e.method)).name.lower().replace("_", " ")}
             print(f"f = {f:g}: {q} extrapolated to h -> 0: {float(e.value):.4g} +- {float(e.uncertainty):.2g} "
                   f"({ex[q]['method']}, order {float(e.order):.2f})")
         suffix = (" graded" if args.graded else "") + ("" if args.flip == 1.0 else f" flip {args.flip:g}")

@@ -92,7 +92,8 @@ def main() -> None:
             data["records"].append(prow_record(state, const, t0))
             out.write_text(json.dumps(data, indent=1) + "\n")
         if args.stop_um is not None and state.sphere.slid_m * 1e6 >= args.stop_um:
-            data["records"].append(prow_record(state, const, t0))
+            if state.step % args.every:  # the record of this step is not there yet
+                data["records"].append(prow_record(state, const, t0))
             raise ProbeEnd(f"ended by --stop-um after {state.sphere.slid_m * 1e6:.1f} um of sliding")
 
     solver.step = step_and_record  # the run loop calls solver.step: the probe sees every step
