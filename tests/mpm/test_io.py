@@ -1,4 +1,4 @@
-"""plough.mpm.io: the residual cross-sections behind the sphere (dg, hpu, dp)."""
+"""plough.mpm.io: the residual cross-sections behind the sphere (dg, hpu, dp) and the steadiness check."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
+from plough.mpm import io
 from plough.mpm.io import residual_profiles
 from plough.mpm.scene import Scene
 
@@ -146,3 +147,48 @@ def test_snapshot_is_vtk_polydata_with_the_particle_fields(tmp_path):
     np.testing.assert_allclose(decode(piece.find("Points/DataArray")), p.x, rtol=1e-6)
     h = scene.discretisation.particle_size_m
     np.testing.assert_allclose(np.unique(np.round(arrays["size_m"][:, 0] / h, 5)), [1.0, 2.0])
+
+
+# ----------------------------------------------------------------------------- steadiness of the window
+def _series(fx, fz, top):
+    return {"Fx": np.asarray(fx, float), "Fz": np.asarray(fz, float), "material_top": np.asarray(top, float)}
+
+
+def test_constant_window_is_steady_with_zero_drift_and_rise():
+    n = 20
+    mask = np.arange(n) >= 8  # 12 records: halves of 6
+    out = io.steadiness(_series(np.full(n, 0.9), np.full(n, 3.0), np.full(n, 4e-6)), mask, 2.5e-6)
+    assert out == {"mu_drift": 0.0, "material_top_rise": 0.0, "steady": 1}
+
+
+def test_drift_and_rise_are_the_halves_difference():
+    n = 10
+    mask = np.arange(n) >= 2  # records 2..9: first half 2..5, second 6..9
+    fx = np.where(np.arange(n) < 6, 0.8, 1.2)  # mu 0.8/3 then 1.2/3 (Fz constant): drift 0.4 / 1.0
+    top = np.where(np.arange(n) < 6, 5e-6, 20e-6)
+    out = io.steadiness(_series(fx, np.full(n, 3.0), top), mask, 2.5e-6)
+    assert out["mu_drift"] == pytest.approx(0.4)
+    assert out["material_top_rise"] == pytest.approx(15e-6)
+    assert out["steady"] == 0
+    # records outside the window do not count: the same halves with wild values outside it
+    fx_out, top_out = fx.copy(), top.copy()
+    fx_out[:2], top_out[:2] = 50.0, 1.0
+    assert io.steadiness(_series(fx_out, np.full(n, 3.0), top_out), mask, 2.5e-6) == out
+
+
+@pytest.mark.parametrize("drift_ok", [True, False])
+def test_each_criterion_alone_decides(drift_ok):
+    n, h = 8, 5e-6
+    mask = np.ones(n, bool)
+    mu_2 = 1.0 + (0.9 if drift_ok else 3) * io.STEADY_MU_DRIFT  # (mu_2 - 1) / mean mu just inside / outside
+    fx = np.where(np.arange(n) < 4, 1.0, mu_2)
+    top_rise = (0.5 if not drift_ok else 3.0) * io.STEADY_TOP_RISE_PARTICLES * h  # the other one fails
+    top = np.where(np.arange(n) < 4, 0.0, top_rise)
+    out = io.steadiness(_series(fx, np.ones(n), top), mask, h)
+    assert (abs(out["mu_drift"]) <= io.STEADY_MU_DRIFT) is drift_ok
+    assert (out["material_top_rise"] <= io.STEADY_TOP_RISE_PARTICLES * h) is (not drift_ok)
+    assert out["steady"] == 0
+    # and with both inside the limits the window is steady; a falling top counts as steady
+    out = io.steadiness(_series(np.where(np.arange(n) < 4, 1.0, 1.0 + 0.5 * io.STEADY_MU_DRIFT), np.ones(n), -top),
+                        mask, h)
+    assert out["steady"] == 1 and out["material_top_rise"] < 0

@@ -143,6 +143,30 @@ def test_material_top_bounds_the_residual_surface(tiny_run, tiny_scene):
     assert top.max() < tiny_scene.grid_headroom_m
 
 
+def test_steadiness_is_reported_from_the_run_records(tiny_run, tiny_scene):
+    ds = tiny_run
+    mask = ds.in_steady_window.values
+    idx = np.flatnonzero(mask)
+    first, second = idx[: idx.size // 2], idx[idx.size // 2:]
+    mu = float(ds.mu)
+    mu_1 = ds.Fx.values[first].mean() / ds.Fz.values[first].mean()
+    mu_2 = ds.Fx.values[second].mean() / ds.Fz.values[second].mean()
+    assert float(ds.mu_drift) == pytest.approx((mu_2 - mu_1) / mu, rel=1e-12)
+    rise = ds.material_top.values[second].mean() - ds.material_top.values[first].mean()
+    assert float(ds.material_top_rise) == pytest.approx(rise, rel=1e-12, abs=1e-18)
+    h = tiny_scene.discretisation.particle_size_m
+    expected = abs(float(ds.mu_drift)) <= io.STEADY_MU_DRIFT and rise <= io.STEADY_TOP_RISE_PARTICLES * h
+    assert int(ds.steady) == int(expected)
+
+
+def test_unsteady_window_warns(tiny_scene, monkeypatch):
+    """simulate() warns when the window is not steady (here: a drift limit no window can meet)."""
+    monkeypatch.setattr(io, "STEADY_MU_DRIFT", -1.0)
+    with pytest.warns(run_module.SteadyStateWarning, match="not a steady state"):
+        ds = simulate(tiny_scene, progress=False)
+    assert int(ds.steady) == 0
+
+
 def test_units_and_long_names(tiny_run):
     for name, var in tiny_run.variables.items():
         assert "units" in var.attrs, name

@@ -111,6 +111,7 @@ def fake_run(scene: dict) -> xr.Dataset:
         ds[f"{part}_eps_p"] = ((f"{part}_particle",), rng.uniform(0, 0.5, n).astype(np.float32), {"units": "1"})
     for o, (u, ln) in STEADY_META.items():
         ds[o] = ((), value(o, sig, h, noisy), {"units": u, "long_name": ln})
+    ds["steady"] = ((), np.int8(not noisy), {"units": "1", "long_name": "steady window (fake: 0 for the noisy runs)"})
     ds.attrs.update(cost_wall_time_s=100.0 / h, scene=to_json(scene),
                     coating_representation=f"fake representation of {scene['name']}",
                     sphere_centre_end_m=np.array([2e-4, 0.0, 4.9e-4]), midplane_section_x_m=1e-4)
@@ -190,6 +191,7 @@ def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path)
                                                                                          noisy))
             for h in SIZES:
                 assert float(ds["wall_time_s"].sel(sel).sel(h=h)) == pytest.approx(100.0 / h)
+                assert float(ds["steady"].sel(sel).sel(h=h)) == float(not noisy)  # each run's own flag
             expected = matrix.analytical_values(matrix.real_point(real, label, load, r1))
             for o, v in expected.items():
                 assert np.isfinite(v)
@@ -319,7 +321,7 @@ def test_fig19_keeps_the_finest_run_of_its_case(run_files, tmp_path):
         np.testing.assert_array_equal(sub[name].values, run[name].values)
     np.testing.assert_array_equal(ds["sliding_distance"].values, run["sliding_distance"].values)
     np.testing.assert_array_equal(sub["in_steady_window"].values.astype(bool), run["in_steady_window"].values)
-    for o in (*matrix.OUTPUTS, "Fz_mean"):
+    for o in (*matrix.OUTPUTS, "Fz_mean", "steady"):
         assert float(sub[o]) == float(run[o]), o
     for o, v in matrix.analytical_values(point).items():
         assert float(sub[f"{o}_analytical"]) == pytest.approx(v, rel=1e-12), o
@@ -369,6 +371,20 @@ def test_sphere_position_reaches_the_fig12_picture(run_files):
     """plot_fig12 draws the sphere from the run's attribute sphere_centre_end_m, kept per case."""
     ds = build_dataset(SMOKE, "fig12", run_files)
     np.testing.assert_allclose(ds.attrs["sphere_centre_end_m_coated"], [2e-4, 0.0, 4.9e-4])
+
+
+@pytest.mark.parametrize("figure", ["fig15", "fig19"])
+def test_result_files_from_before_the_steadiness_check_still_build(run_files, tmp_path, figure):
+    """Cached runs written before io.steadiness existed have no 'steady': the figure's dataset
+    is built without it (no all-missing variable), everything else unchanged."""
+    old = {}
+    for rid, path in run_files.items():
+        old[rid] = tmp_path / f"{rid}.nc"
+        xr.load_dataset(path).drop_vars("steady").to_netcdf(old[rid])
+    without = build_dataset(SMOKE, figure, old)
+    with_check = build_dataset(SMOKE, figure, run_files)
+    assert "steady" in with_check and "steady" not in without
+    xr.testing.assert_identical(without, with_check.drop_vars("steady"))
 
 
 def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):

@@ -5,6 +5,9 @@ plus ``dg`` (groove depth below the original surface), ``hpu`` (pile-up height a
 ``penetration`` (depth of the sphere's lowest point under load), so the two compare directly:
 mu = mean Fx / mean Fz over the steady window, mu_pl and mu_sh the same with the normal-traction
 and interface-shear parts of Fx; dp = dg + hpu from the residual cross-sections (Fig. 14c).
+Whether the window is a steady state is checked, not assumed: ``mu_drift`` (mu of the window's
+second half against its first) and ``material_top_rise`` (how far the highest particle rose
+between the halves: a growing prow) give ``steady``.
 
 Snapshots are VTK XML PolyData (.vtp) files, which ParaView and OVITO open.
 """
@@ -55,6 +58,40 @@ STEADY_META = {
     "dp": ("m", "ploughing depth dp = dg + hpu"),
     "max_particle_penetration": ("m", "deepest penetration of a particle centre into the sphere (whole run)"),
 }
+
+#: a window is steady when mu moves by at most this fraction between its halves ...
+STEADY_MU_DRIFT = 0.05
+#: ... and the highest particle rises by at most this many particle sizes (a prow that comes and goes
+#: moves its top by about a particle; the growing prows at h = 2.5 um rose by tens of um over 0.3 mm)
+STEADY_TOP_RISE_PARTICLES = 2.0
+STEADINESS_META = {
+    "mu_drift": ("1", "mu over the second half of the steady window minus mu over its first half, relative to mu"),
+    "material_top_rise": ("m", "mean highest particle over the second half of the steady window minus over its first"),
+    "steady": ("1", f"1 if the window is a steady state: |mu_drift| <= {STEADY_MU_DRIFT:g} and material_top_rise <= "
+               f"{STEADY_TOP_RISE_PARTICLES:g} particle sizes, else 0"),
+}
+
+
+def steadiness(series: dict[str, np.ndarray], mask: np.ndarray, particle_size_m: float) -> dict[str, float | int]:
+    """Does the steady window hold a steady state? Compares its two halves (by record count).
+
+    mu_drift = (mu_2 - mu_1) / mu with mu_k = mean Fx / mean Fz over half k; material_top_rise is the
+    mean of ``material_top`` over the second half minus over the first. A window of fewer than 2
+    records cannot be split: it is reported with drift and rise 0.
+    """
+    idx = np.flatnonzero(mask)
+    half = idx.size // 2
+    if half == 0:
+        return {"mu_drift": 0.0, "material_top_rise": 0.0, "steady": 1}
+    first, second = idx[:half], idx[half:]
+    fx, fz, top = series["Fx"], series["Fz"], series["material_top"]
+    mu = fx[idx].mean() / fz[idx].mean()
+    mu_1 = fx[first].mean() / fz[first].mean()
+    mu_2 = fx[second].mean() / fz[second].mean()
+    drift = (mu_2 - mu_1) / abs(mu) if mu != 0 else 0.0
+    rise = top[second].mean() - top[first].mean()
+    steady = abs(drift) <= STEADY_MU_DRIFT and rise <= STEADY_TOP_RISE_PARTICLES * particle_size_m
+    return {"mu_drift": float(drift), "material_top_rise": float(rise), "steady": int(steady)}
 
 
 def steady_window_mask(slid_m: np.ndarray, scene: Scene, distance_m: float | None = None) -> np.ndarray:
@@ -242,6 +279,9 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     for name, value in steady.items():
         u, ln = STEADY_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
+    for name, value in steadiness(series, mask, scene.discretisation.particle_size_m).items():
+        u, ln = STEADINESS_META[name]
+        ds[name] = ((), np.int8(value) if name == "steady" else value, {"units": u, "long_name": ln})
     ds.attrs["forces_and_energies"] = ("full body (twice the simulated half with the mirror plane)"
                                        if scene.domain.symmetric else "full body")
     for name, value in cost.items():

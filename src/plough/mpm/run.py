@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import time
+import warnings
 from collections.abc import Callable
 from pathlib import Path
 
@@ -104,6 +105,10 @@ class SteadyStop:
                 and max(last) - min(last) <= self.tolerance * abs(float(np.mean(last))))
 
 
+class SteadyStateWarning(UserWarning):
+    """The run's steady window does not hold a steady state (``io.steadiness``)."""
+
+
 def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path | None = None,
              threads: int | None = None) -> xr.Dataset:
     """Run the MPM ploughing simulation of ``scene`` and return its results dataset."""
@@ -151,8 +156,14 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     n = state.particles.n
     cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
             "dt_s": const.dt, "particle_steps_per_s": n * state.step / wall, "threads": numba.get_num_threads()}
-    return io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
-                            rec.max_penetration, coating_row, slid_distance_m=slid_distance)
+    ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
+                          rec.max_penetration, coating_row, slid_distance_m=slid_distance)
+    if not ds["steady"]:
+        warnings.warn(f"scene {scene.name!r}: the steady window is not a steady state (mu moved "
+                      f"{float(ds.mu_drift):+.1%} from its first half to its second, the highest particle rose "
+                      f"{float(ds.material_top_rise) * 1e6:.1f} um); mu and dp are means of a changing state "
+                      "(variables mu_drift, material_top_rise, steady)", SteadyStateWarning, stacklevel=2)
+    return ds
 
 
 def _progress(scene: Scene, enabled: bool):

@@ -22,7 +22,7 @@ import numpy as np
 import xarray as xr
 
 from plough.io import provenance_attrs
-from plough.mpm.io import STEADY_META
+from plough.mpm.io import STEADINESS_META, STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import extrapolate_dataarray
 from plough.study.skipping import is_skipped
@@ -76,6 +76,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     shape = (len(labels), len(panel.values), len(sizes_um))
     per_size = {o: np.full(shape, np.nan) for o in (*matrix.OUTPUTS, "Fz_mean", "max_particle_penetration")}
     wall = np.full(shape, np.nan)
+    steady = np.full(shape, np.nan)  # stays NaN for skipped runs and files written before the check
     analytical = {o: np.full(shape[:2], np.nan) for o in matrix.ANALYTICAL_OUTPUTS}
     skipped = np.zeros(shape[:2], dtype=bool)
     for i, series in enumerate(panel.series):
@@ -93,6 +94,8 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                 for o in per_size:
                     per_size[o][i, j, k] = float(ds[o])
                 wall[i, j, k] = float(ds.attrs["cost_wall_time_s"])
+                if "steady" in ds:
+                    steady[i, j, k] = float(ds["steady"])
             for o, v in matrix.analytical_values(point).items():
                 analytical[o][i, j] = v
     dims3 = (panel.series_dim, panel.axis, "h")
@@ -123,6 +126,10 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                                            "allow_missing": 1})
     out[f"wall_time_s{suffix}"] = (dims3, wall, {"units": "s", "long_name": "wall time of the run",
                                                  **({"allow_missing": 1} if skipped.any() else {})})
+    if np.isfinite(steady).any():  # result files written before the check carry none
+        out[f"steady{suffix}"] = (dims3, steady, {"units": "1", "allow_missing": 1,
+                                                  "long_name": STEADINESS_META["steady"][1] + " (per run; missing: "
+                                                  "skipped, or written before the check)"})
     out[f"skipped_finest{suffix}"] = ((panel.series_dim, panel.axis), skipped.astype(np.int8),
                                       {"units": "1", "long_name": "finest size skipped (mpm.skip_finest_tolerance): "
                                        "extrapolated from the two coarser sizes"})
@@ -151,6 +158,8 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
         sub = run[[v for v in keep if v in run]]
         for o in (*matrix.OUTPUTS, "Fz_mean"):
             sub[o] = run[o]
+        if all("steady" in runs[matrix.run_id(p, h)] for p in cases.values()):  # files from before the check lack it
+            sub["steady"] = ((), np.int8(run["steady"]), {"units": "1", "long_name": STEADINESS_META["steady"][1]})
         for o, v in matrix.analytical_values(point).items():
             units, long_name = STEADY_META[o]
             sub[f"{o}_analytical"] = ((), v, {"units": units, "long_name": f"{long_name} (analytical model)"})
