@@ -33,4 +33,6 @@ def run_scene(scene: Scene, threads: int) -> dict:
                wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
                steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]),
                material_top_max_m=float(ds.material_top.max()), grid_nodes=int(ds.attrs["cost_grid_nodes"]))
+    for q in ("mu_drift", "material_top_rise", "steady"):  # plough.mpm.io.steadiness
+        row[q] = float(ds[q])
     return row

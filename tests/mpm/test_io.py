@@ -188,7 +188,33 @@ def test_each_criterion_alone_decides(drift_ok):
     assert (abs(out["mu_drift"]) <= io.STEADY_MU_DRIFT) is drift_ok
     assert (out["material_top_rise"] <= io.STEADY_TOP_RISE_PARTICLES * h) is (not drift_ok)
     assert out["steady"] == 0
-    # and with both inside the limits the window is steady; a falling top counts as steady
-    out = io.steadiness(_series(np.where(np.arange(n) < 4, 1.0, 1.0 + 0.5 * io.STEADY_MU_DRIFT), np.ones(n), -top),
-                        mask, h)
-    assert out["steady"] == 1 and out["material_top_rise"] < 0
+    # both inside the limits: steady
+    small = np.where(np.arange(n) < 4, 0.0, 0.5 * io.STEADY_TOP_RISE_PARTICLES * h)
+    fx_small = np.where(np.arange(n) < 4, 1.0, 1.0 + 0.5 * io.STEADY_MU_DRIFT)
+    assert io.steadiness(_series(fx_small, np.ones(n), small), mask, h)["steady"] == 1
+    assert io.steadiness(_series(fx_small, np.ones(n), -small), mask, h)["steady"] == 1
+
+
+def test_a_falling_top_is_a_change_too():
+    """A prow shedding material: the top falls by more than the limit."""
+    n, h = 8, 2.5e-6
+    top = np.where(np.arange(n) < 4, 30e-6, 10e-6)
+    out = io.steadiness(_series(np.ones(n), np.ones(n), top), np.ones(n, bool), h)
+    assert out["material_top_rise"] == pytest.approx(-20e-6)
+    assert out["mu_drift"] == 0.0 and out["steady"] == 0
+
+
+def test_a_half_without_normal_force_is_finite_and_not_steady():
+    """The sphere bounced off over one half (mean Fz <= 0 there): no inf or NaN, and not steady."""
+    n = 8
+    fz = np.where(np.arange(n) < 4, 0.0, 3.0)
+    fx = np.where(np.arange(n) < 4, 0.0, 0.9)
+    out = io.steadiness(_series(fx, fz, np.zeros(n)), np.ones(n, bool), 5e-6)
+    assert np.isfinite(out["mu_drift"]) and out["steady"] == 0
+    # drift of the halves' Fx over the window's Fz, relative to the window's mu: (0.9 - 0) / 0.45
+    assert out["mu_drift"] == pytest.approx(2.0)
+
+
+def test_a_window_too_short_to_split_is_not_called_steady():
+    out = io.steadiness(_series(np.ones(3), np.ones(3), np.zeros(3)), np.array([False, False, True]), 5e-6)
+    assert out == {"mu_drift": 0.0, "material_top_rise": 0.0, "steady": 0}

@@ -159,12 +159,16 @@ def test_steadiness_is_reported_from_the_run_records(tiny_run, tiny_scene):
     assert int(ds.steady) == int(expected)
 
 
-def test_unsteady_window_warns(tiny_scene, monkeypatch):
-    """simulate() warns when the window is not steady (here: a drift limit no window can meet)."""
-    monkeypatch.setattr(io, "STEADY_MU_DRIFT", -1.0)
-    with pytest.warns(run_module.SteadyStateWarning, match="not a steady state"):
-        ds = simulate(tiny_scene, progress=False)
-    assert int(ds.steady) == 0
+def test_an_unsteady_window_warns_and_a_steady_one_does_not(tiny_run):
+    import warnings
+
+    unsteady = tiny_run.assign(steady=tiny_run.steady * 0)
+    with pytest.warns(run_module.SteadyStateWarning, match="'tiny': the steady window is not a steady state"):
+        run_module.warn_if_unsteady(unsteady, "tiny")
+    steady = tiny_run.assign(steady=tiny_run.steady * 0 + 1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        run_module.warn_if_unsteady(steady, "tiny")
 
 
 def test_units_and_long_names(tiny_run):

@@ -217,8 +217,9 @@ def test_fig11_has_two_panels_with_suffixed_variables(run_files, tmp_path):
     assert list(ds["interface"].values) == list(rs["interfaces"])
     assert list(ds["coating"].values) == ["soft", "hard"]
     for name in ("dp_h0_a", "dp_h0_uncertainty_b", "dp_h0_order_a", "dp_h0_method_b", "dp_h0_flagged_a",
-                 "mu_analytical_b", "wall_time_s_a"):
+                 "mu_analytical_b", "wall_time_s_a", "steady_a", "steady_b"):
         assert name in ds, name
+    assert ds["steady_a"].dims == ds["dp_a"].dims and "steady" not in ds
     assert ds.attrs["ratio_sweep_thickness_um"] == float(rs["thickness_um"])
 
     hs_a, t_a = float(rs["substrate_hardness_MPa"]), float(rs["thickness_um"])
@@ -385,6 +386,39 @@ def test_result_files_from_before_the_steadiness_check_still_build(run_files, tm
     with_check = build_dataset(SMOKE, figure, run_files)
     assert "steady" in with_check and "steady" not in without
     xr.testing.assert_identical(without, with_check.drop_vars("steady"))
+
+
+def test_a_mix_of_old_and_new_result_files(run_files, tmp_path):
+    """Some runs from before the steadiness check: a sweep keeps the flag of the others and leaves
+    the old ones missing; a single-run figure drops the flag unless every case has it."""
+    sweep_old = set()
+    paths = dict(run_files)
+    for k, rid in enumerate(sorted(run_files)):
+        if k % 2:
+            paths[rid] = tmp_path / f"{rid}.nc"
+            xr.load_dataset(run_files[rid]).drop_vars("steady").to_netcdf(paths[rid])
+            sweep_old.add(rid)
+    ds = build_dataset(SMOKE, "fig15", paths)
+    flags = ds["steady"].values
+    assert np.isnan(flags).any() and np.isfinite(flags).any()
+    real = MPM["real_materials"]
+    r1 = float(real["ball_radii_um"][0])
+    substrates = {"zinc_block": "zinc_bulk", "steel": "dx56"}
+    for label in substrates:
+        for load in (float(x) for x in real["loads_N"]):
+            for h in SIZES:
+                rid = matrix.run_id(matrix.real_point(real, label, load, r1), h)
+                v = float(ds["steady"].sel(material=label, load_N=load, h=h))
+                assert np.isnan(v) if rid in sweep_old else v == float(xr.load_dataset(run_files[rid])["steady"])
+    assert ds["steady"].attrs["allow_missing"] == 1
+    cases = matrix.figure_points(SMOKE, "fig17")  # two cases
+    finest = sorted(matrix.run_id(p, min(SIZES)) for p in cases.values())
+    assert len(finest) >= 2
+    one_old = dict(run_files)
+    one_old[finest[0]] = tmp_path / "one_old.nc"
+    xr.load_dataset(run_files[finest[0]]).drop_vars("steady").to_netcdf(one_old[finest[0]])
+    assert "steady" in build_dataset(SMOKE, "fig17", run_files)
+    assert "steady" not in build_dataset(SMOKE, "fig17", one_old)
 
 
 def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):

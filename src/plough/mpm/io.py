@@ -61,13 +61,13 @@ STEADY_META = {
 
 #: a window is steady when mu moves by at most this fraction between its halves ...
 STEADY_MU_DRIFT = 0.05
-#: ... and the highest particle rises by at most this many particle sizes (a prow that comes and goes
+#: ... and the highest particle rises (or falls) by at most this many particle sizes (a prow that comes and goes
 #: moves its top by about a particle; the growing prows at h = 2.5 um rose by tens of um over 0.3 mm)
 STEADY_TOP_RISE_PARTICLES = 2.0
 STEADINESS_META = {
     "mu_drift": ("1", "mu over the second half of the steady window minus mu over its first half, relative to mu"),
     "material_top_rise": ("m", "mean highest particle over the second half of the steady window minus over its first"),
-    "steady": ("1", f"1 if the window is a steady state: |mu_drift| <= {STEADY_MU_DRIFT:g} and material_top_rise <= "
+    "steady": ("1", f"1 if the window is a steady state: |mu_drift| <= {STEADY_MU_DRIFT:g} and |material_top_rise| <= "
                f"{STEADY_TOP_RISE_PARTICLES:g} particle sizes, else 0"),
 }
 
@@ -75,22 +75,27 @@ STEADINESS_META = {
 def steadiness(series: dict[str, np.ndarray], mask: np.ndarray, particle_size_m: float) -> dict[str, float | int]:
     """Does the steady window hold a steady state? Compares its two halves (by record count).
 
-    mu_drift = (mu_2 - mu_1) / mu with mu_k = mean Fx / mean Fz over half k; material_top_rise is the
-    mean of ``material_top`` over the second half minus over the first. A window of fewer than 2
-    records cannot be split: it is reported with drift and rise 0.
+    mu_drift = (mu_2 - mu_1) / mu with mu_k = mean Fx / mean Fz over half k (when a half's mean Fz is
+    not positive, a bounce, the halves' Fx over the window's Fz instead, and the window is not
+    steady); material_top_rise is the mean of ``material_top`` over the second half minus over the
+    first. A falling top counts as a change too (a prow shedding material). A window of fewer than
+    2 records cannot be split: drift and rise 0, not steady.
     """
     idx = np.flatnonzero(mask)
     half = idx.size // 2
     if half == 0:
-        return {"mu_drift": 0.0, "material_top_rise": 0.0, "steady": 1}
+        return {"mu_drift": 0.0, "material_top_rise": 0.0, "steady": 0}
     first, second = idx[:half], idx[half:]
     fx, fz, top = series["Fx"], series["Fz"], series["material_top"]
-    mu = fx[idx].mean() / fz[idx].mean()
-    mu_1 = fx[first].mean() / fz[first].mean()
-    mu_2 = fx[second].mean() / fz[second].mean()
-    drift = (mu_2 - mu_1) / abs(mu) if mu != 0 else 0.0
+    fz_window = fz[idx].mean()
+    mu = fx[idx].mean() / fz_window
+    fz_1, fz_2 = fz[first].mean(), fz[second].mean()
+    bounced = not (fz_1 > 0 and fz_2 > 0)
+    if bounced:
+        fz_1 = fz_2 = fz_window
+    drift = (fx[second].mean() / fz_2 - fx[first].mean() / fz_1) / abs(mu) if mu != 0 else 0.0
     rise = top[second].mean() - top[first].mean()
-    steady = abs(drift) <= STEADY_MU_DRIFT and rise <= STEADY_TOP_RISE_PARTICLES * particle_size_m
+    steady = not bounced and abs(drift) <= STEADY_MU_DRIFT and abs(rise) <= STEADY_TOP_RISE_PARTICLES * particle_size_m
     return {"mu_drift": float(drift), "material_top_rise": float(rise), "steady": int(steady)}
 
 

@@ -158,12 +158,17 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
             "dt_s": const.dt, "particle_steps_per_s": n * state.step / wall, "threads": numba.get_num_threads()}
     ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
                           rec.max_penetration, coating_row, slid_distance_m=slid_distance)
-    if not ds["steady"]:
-        warnings.warn(f"scene {scene.name!r}: the steady window is not a steady state (mu moved "
-                      f"{float(ds.mu_drift):+.1%} from its first half to its second, the highest particle rose "
-                      f"{float(ds.material_top_rise) * 1e6:.1f} um); mu and dp are means of a changing state "
-                      "(variables mu_drift, material_top_rise, steady)", SteadyStateWarning, stacklevel=2)
+    warn_if_unsteady(ds, scene.name)
     return ds
+
+
+def warn_if_unsteady(ds: xr.Dataset, name: str) -> None:
+    """Warn (SteadyStateWarning) when the run's steady window is not a steady state (``io.steadiness``)."""
+    if not int(ds["steady"]):
+        warnings.warn(f"scene {name!r}: the steady window is not a steady state (mu moved "
+                      f"{float(ds.mu_drift):+.1%} from its first half to its second, the highest particle "
+                      f"{float(ds.material_top_rise) * 1e6:+.1f} um); mu and dp are means of a changing state "
+                      "(variables mu_drift, material_top_rise, steady)", SteadyStateWarning, stacklevel=3)
 
 
 def _progress(scene: Scene, enabled: bool):

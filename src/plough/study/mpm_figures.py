@@ -152,14 +152,16 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
     cases = matrix.figure_points(config, figure)
     h = matrix.particle_sizes_um(config)[-1]
     keep = SINGLE_RUN_VARIABLES[figure]
+    # result files from before the steadiness check lack the flag: carry it only when every case has it
+    with_steady = all("steady" in runs[matrix.run_id(p, h)] for p in cases.values())
     parts = []
     for label, point in cases.items():
         run = runs[matrix.run_id(point, h)]
         sub = run[[v for v in keep if v in run]]
         for o in (*matrix.OUTPUTS, "Fz_mean"):
             sub[o] = run[o]
-        if all("steady" in runs[matrix.run_id(p, h)] for p in cases.values()):  # files from before the check lack it
-            sub["steady"] = ((), np.int8(run["steady"]), {"units": "1", "long_name": STEADINESS_META["steady"][1]})
+        if with_steady:
+            sub["steady"] = ((), np.int8(int(run["steady"])), {"units": "1", "long_name": STEADINESS_META["steady"][1]})
         for o, v in matrix.analytical_values(point).items():
             units, long_name = STEADY_META[o]
             sub[f"{o}_analytical"] = ((), v, {"units": units, "long_name": f"{long_name} (analytical model)"})
