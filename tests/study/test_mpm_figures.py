@@ -479,3 +479,26 @@ def test_a_skip_marker_at_a_coarser_size_is_refused(run_files, tmp_path):
     config["mpm"]["skip_finest_tolerance"] = 0.05
     with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
         build_dataset(config, "fig15", paths)
+
+
+def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
+    """The per-size points of runs with steady = 0 (the fake noisy steel runs) get a cross, once in the legend;
+    without the flag (files from before the check) no cross is drawn."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from plough.figures import mpm as mpm_figures
+
+    ds = build_dataset(SMOKE, "fig15", run_files)
+    n_bad = int((ds["steady"] == 0).sum())
+    assert n_bad == len(SIZES)  # the steel at the highest load, at every size
+    for data, crosses in ((ds, n_bad), (ds.drop_vars("steady"), 0)):
+        fig, ax = plt.subplots()
+        mpm_figures._sweep_panel(ax, data, "mu", "")
+        crossed = [line for line in ax.lines if line.get_marker() == "x"]
+        assert sum(len(line.get_xdata()) for line in crossed) == crosses
+        labels = [line.get_label() for line in crossed if not line.get_label().startswith("_")]
+        assert len(labels) == (1 if crosses else 0)
+        plt.close(fig)

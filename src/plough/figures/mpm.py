@@ -1,5 +1,6 @@
-"""MPM figures (Figs. 11-21, 23): extrapolated MPM marks with uncertainty bars, per-size values faint,
-analytical lines, the coating-wear region shaded where dp > t, and pictures from particle data."""
+"""MPM figures (Figs. 11-21, 23): extrapolated MPM marks with uncertainty bars, per-size values faint
+(crossed where the run's window was not a steady state), analytical lines, the coating-wear region
+shaded where dp > t, and pictures from particle data."""
 
 from __future__ import annotations
 
@@ -42,12 +43,20 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
     series_dim, axis = per_size.dims[0], per_size.dims[1]
     x = ds[axis].values
     h_values = ds["h"].values
+    steady = ds.get(f"steady{suffix}")  # per run; absent for result files from before the check
+    unsteady_label = "run not steady (mu_drift or prow growth in its window)"
     for i, label in enumerate(ds[series_dim].values):
         colour = SERIES_COLOURS[i % len(SERIES_COLOURS)]
         sel = {series_dim: label}
         for k, h in enumerate(h_values):
-            ax.plot(x, per_size.sel(sel).isel(h=k) * scale, ls="none", marker=SIZE_MARKERS[k % 5], ms=3.5,
+            y = per_size.sel(sel).isel(h=k).values * scale
+            ax.plot(x, y, ls="none", marker=SIZE_MARKERS[k % 5], ms=3.5,
                     color=colour, alpha=0.3, label=f"h = {h:g} µm" if i == 0 else None)
+            if steady is not None:
+                bad = steady.sel(sel).isel(h=k).values == 0
+                if bad.any():
+                    ax.plot(x[bad], y[bad], ls="none", marker="x", ms=5, color="k", label=unsteady_label)
+                    unsteady_label = None
         val = ds[f"{quantity}_h0{suffix}"].sel(sel).values * scale
         unc = ds[f"{quantity}_h0_uncertainty{suffix}"].sel(sel).values * scale
         flagged = ds[f"{quantity}_h0_flagged{suffix}"].sel(sel).values.astype(bool)
