@@ -171,6 +171,15 @@ def test_an_unsteady_window_warns_and_a_steady_one_does_not(tiny_run):
         run_module.warn_if_unsteady(steady, "tiny")
 
 
+def test_warm_up_does_not_warn_about_its_own_scene(monkeypatch):
+    import warnings
+
+    monkeypatch.setattr(io, "STEADY_MU_DRIFT", -1.0)  # no window is steady: simulate() alone would warn
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", run_module.SteadyStateWarning)
+        run_module.warm_up(threads=1)
+
+
 def test_units_and_long_names(tiny_run):
     for name, var in tiny_run.variables.items():
         assert "units" in var.attrs, name
