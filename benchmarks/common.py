@@ -33,6 +33,7 @@ def run_scene(scene: Scene, threads: int) -> dict:
                wall_s=float(ds.attrs["cost_wall_time_s"]), total_s=time.perf_counter() - t0,
                steps=int(ds.attrs["cost_steps"]), particles=int(ds.attrs["cost_particles"]),
                material_top_max_m=float(ds.material_top.max()), grid_nodes=int(ds.attrs["cost_grid_nodes"]))
+    row["active_fraction"] = float(ds.attrs.get("cost_active_fraction", 1.0))  # share of particle-steps worked on
     for q in ("mu_drift", "material_top_rise", "steady"):  # plough.mpm.io.steadiness
         row[q] = float(ds[q])
     return row

@@ -61,16 +61,16 @@ def main() -> None:
     lo, hi, far = origin + dx, origin + dx * (shape - 2), np.ones(3)
 
     def kinematics(project: int) -> None:
-        tr.g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, 1.0, buf, project)
+        tr.g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, 1.0, buf, project, 0, n, 0, buf.shape[1])
 
     def update(project: int) -> None:
         tr.g2p_update(origin, dx, 1e-9, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, mat, mat,
-                      frac, table, 1.0, 0.9, far, 1e-6, 3 * dx, near, acc, lo, hi, grid_div, project, L_buf)
+                      frac, table, 1.0, 0.9, far, 1e-6, 3 * dx, near, acc, lo, hi, grid_div, project, L_buf, 0, n)
 
     def step(project: int) -> None:
         kinematics(project)
         if project:
-            tr.grid_dilatation(buf, grid_div, shape, -1)
+            tr.grid_dilatation(buf, grid_div, shape, -1, 0, buf.shape[1])
         update(project)
 
     # local and projected steps alternate, so that both see the same machine state; the ratio is
@@ -88,7 +88,7 @@ def main() -> None:
         projected.append(t[1])
         ratio.append(t[1] / t[0])
     parts = {"g2p_kinematics": [median_ms(lambda: kinematics(0)), median_ms(lambda: kinematics(1))],
-             "grid_dilatation": [0.0, median_ms(lambda: tr.grid_dilatation(buf, grid_div, shape, -1))],
+             "grid_dilatation": [0.0, median_ms(lambda: tr.grid_dilatation(buf, grid_div, shape, -1, 0, buf.shape[1]))],
              "g2p_update": [median_ms(lambda: update(0)), median_ms(lambda: update(1))]}
     print(f"{n:,} particles, {args.threads} threads, ms per call (median of {args.repeats})")
     print("| kernel | local | projected |\n|---|---|---|")

@@ -23,7 +23,8 @@ from plough.mpm.solver import SimulationError
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = yaml.safe_load((ROOT / "examples" / "stability_small.yaml").read_text())
-ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss")
+ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
+                "frozen_kinetic_loss")
 
 
 def variant(**changes) -> dict:

@@ -305,7 +305,7 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     near = (rng.random(n) < 0.7).astype(np.int8)
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
     ct.scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near,
-                              ORIGIN, DX, SHAPE, centre, radius, -1, cbuf)
+                              ORIGIN, DX, SHAPE, centre, radius, -1, cbuf, 0, n)
     # independent accumulation
     sy = np.array([450e6 / 3, 900e6 / 3])
     kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
@@ -456,7 +456,7 @@ def _scatter_block(x, h, centre, radius, mirror_j0=-1):
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
     ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, zeros, np.full(n, 298.0),
                               np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones, table,
-                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, mirror_j0, cbuf)
+                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, mirror_j0, cbuf, 0, n)
     return cbuf
 
 

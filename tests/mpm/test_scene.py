@@ -146,6 +146,12 @@ BAD = {
     "unknown interface model": (_mutate(interface={"model": "magic"}), r"interface\.model"),
     "symmetric not a bool": (_mutate(domain__symmetric="yes"), r"domain\.symmetric"),
     "records too few": (_mutate(outputs__records=5), r"outputs\.records"),
+    "active zone below 2 contact radii": (_mutate(discretisation__active_zone_contact_radii=1.5),
+                                          r"discretisation\.active_zone_contact_radii = 1\.5 .*\[2, inf\) or null"),
+    "active zone not finite": (_mutate(discretisation__active_zone_contact_radii=float("inf")),
+                               r"discretisation\.active_zone_contact_radii = inf"),
+    "active zone not a number": (_mutate(discretisation__active_zone_contact_radii="wide"),
+                                 r"discretisation\.active_zone_contact_radii"),
     "rigid-plastic extra key": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": 900, "foo": 1}),
                                 r"layers\.substrate.*foo"),
 }
@@ -412,3 +418,15 @@ def test_headroom_is_validated_round_trips_and_survives_the_presets():
     for bad in (0.0, -1e-6, float("nan")):
         with pytest.raises(ValueError, match=r"domain\.headroom_m"):
             Domain(headroom_m=bad)
+
+
+def test_active_zone_round_trips_and_the_paper_preset_updates_every_particle():
+    s = Scene.from_yaml(Path(__file__).resolve().parents[2] / "examples" / "coated_rigid_plastic.yaml")
+    assert s.discretisation.active_zone_contact_radii is None
+    d = s.to_dict()
+    d["discretisation"]["active_zone_contact_radii"] = "3.0e0"  # YAML 1.1 reads it as a string
+    zoned = Scene.from_dict(d)
+    assert zoned.discretisation.active_zone_contact_radii == 3.0
+    assert Scene.from_yaml(zoned.to_yaml()) == zoned
+    assert zoned.with_sized_domain().discretisation.active_zone_contact_radii == 3.0
+    assert zoned.with_paper_settings().discretisation.active_zone_contact_radii is None

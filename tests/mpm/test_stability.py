@@ -23,7 +23,8 @@ from plough.mpm.scene import CFL_MAX, Scene
 pytestmark = [pytest.mark.slow, pytest.mark.usefixtures("two_threads")]
 
 BASE = yaml.safe_load((Path(__file__).resolve().parents[2] / "examples" / "stability_small.yaml").read_text())
-ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss")
+ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
+                "frozen_kinetic_loss")
 
 
 def scene(**parts) -> Scene:

@@ -31,6 +31,16 @@ RHO = 7850.0
 STIFF = pack_materials([rigid_plastic("stiff", 1e15, coating=False)])  # never yields here
 
 
+def everything(x: np.ndarray, buf: np.ndarray) -> tuple[int, int, int, int]:
+    """The kernels' particle and node ranges covering every particle and node (no active zone)."""
+    return 0, x.shape[0], 0, buf.shape[1]
+
+
+def all_nodes(buf: np.ndarray, shape) -> tuple[int, int, int, int]:
+    """grid_update's node range and free x-index range covering the whole grid (nothing clamped)."""
+    return 0, buf.shape[1], 0, int(shape[0])
+
+
 def node_positions(origin=ORIGIN, dx=DX, shape=SHAPE) -> np.ndarray:
     return Grid(origin=np.asarray(origin), dx=dx, shape=tuple(int(s) for s in shape)).node_positions()
 
@@ -50,12 +60,12 @@ def random_particles(n=300, seed=0, lo_cells=3.0, hi_cells=None):
 def p2g_update(x, v, C, stress, vol0, J, mass, dt, n_chunks=1, flags=None):
     n_nodes = int(np.prod(SHAPE))
     buf = tr.allocate_grid_buffers(n_chunks, n_nodes)
-    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, dt, SHAPE, buf)
+    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, dt, SHAPE, buf, *everything(x, buf))
     grid_m = np.zeros(n_nodes)
     grid_v = np.zeros((n_nodes, 6))
     if flags is None:
         flags = np.full(n_nodes, FREE, dtype=np.int8)
-    tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1)
+    tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1, *all_nodes(buf, SHAPE))
     return buf, grid_m, grid_v[:, :3].copy()  # the new velocity; columns 3:6 are tested on their own
 
 
@@ -126,9 +136,9 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     grid_div = np.zeros(grid_v.shape[0])
     v_grid = np.zeros((n, 3))
     buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
-    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, v, C, v_grid, mass, flip, buf, project)
+    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, v, C, v_grid, mass, flip, buf, project, *everything(x, buf))
     if project:
-        tr.grid_dilatation(buf, grid_div, SHAPE, -1)
+        tr.grid_dilatation(buf, grid_div, SHAPE, -1, 0, buf.shape[1])
     eps_p = np.zeros(n)
     temperature = np.full(n, 298.0)
     mat = np.zeros(n, dtype=np.int32)
@@ -141,7 +151,7 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
     tr.g2p_update(ORIGIN, DX, dt, SHAPE, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, mat, mat, frac,
                   table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, grid_div, project,
-                  tr.allocate_velocity_gradient_scratch(n_chunks))
+                  tr.allocate_velocity_gradient_scratch(n_chunks), 0, x.shape[0])
     return acc, near, eps_p
 
 
@@ -294,7 +304,8 @@ def test_chunked_scatter_gives_same_grid():
         for c in range(n_chunks):
             sl = slice(c * n // n_chunks, (c + 1) * n // n_chunks)
             one = tr.allocate_grid_buffers(1, buf.shape[1])
-            tr.p2g(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl], ORIGIN, DX, 1e-8, SHAPE, one)
+            tr.p2g(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl], ORIGIN, DX, 1e-8, SHAPE, one,
+                   *everything(x[sl], one))
             np.testing.assert_array_equal(buf[c], one[0])
     m1, v1 = results[1]
     vscale = np.abs(v1).max()
@@ -311,7 +322,7 @@ def test_p2g_zeroes_stale_buffer():
     C, stress = np.zeros((n, 3, 3)), np.zeros((n, 6))
     buf = tr.allocate_grid_buffers(2, int(np.prod(SHAPE)))
     buf[:] = 123.0
-    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, buf)
+    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, buf, *everything(x, buf))
     assert buf[:, :, 0].sum() == pytest.approx(mass.sum(), rel=1e-13)
 
 
@@ -326,7 +337,7 @@ def test_grid_update_boundary_conditions():
     flags = rng.choice(np.array([FREE, FIXED, MIRROR], dtype=np.int8), n_nodes)
     grid_m = np.full(n_nodes, -1.0)
     grid_v = np.full((n_nodes, 6), 99.0)
-    tr.grid_update(buf, flags, grid_m, grid_v, np.array([1, 1, n_nodes], dtype=np.int64), -1)
+    tr.grid_update(buf, flags, grid_m, grid_v, np.array([1, 1, n_nodes], dtype=np.int64), -1, 0, n_nodes, 0, 1)
     m = buf[:, :, 0].sum(0)
     mom = buf[:, :, 1:4].sum(0)
     impulse = buf[:, :, 4:7].sum(0)
@@ -398,10 +409,10 @@ def test_mirror_fold_reproduces_the_full_domain():
         shape = np.array(grid.shape, dtype=np.int64)
         buf = tr.allocate_grid_buffers(1, grid.n_nodes)
         tr.p2g(xs, vs, Cs, ss, np.tile(vol0, len(xs) // n), np.tile(J, len(xs) // n), np.tile(mass, len(xs) // n),
-               grid.origin, dx, 1e-7, shape, buf)
+               grid.origin, dx, 1e-7, shape, buf, *everything(xs, buf))
         flags = boundary_flags(grid, 1.0, symmetric)  # radius 1 m: nothing fixed
         gm, gv = np.zeros(grid.n_nodes), np.zeros((grid.n_nodes, 6))
-        tr.grid_update(buf, flags, gm, gv, shape, mirror_plane_index(grid, symmetric))
+        tr.grid_update(buf, flags, gm, gv, shape, mirror_plane_index(grid, symmetric), *all_nodes(buf, shape))
         return gm, gv, flags
 
     gm_h, gv_h, flags_h = grid_v(half_grid, x, v, C, stress, True)
@@ -501,8 +512,9 @@ def test_dilatation_projection_matches_reference_and_conserves_mass_weighted_dil
     grid_div = np.full(grid_v.shape[0], np.nan)
     n = x.shape[0]
     C = np.zeros((n, 3, 3))
-    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, np.zeros((n, 3)), C, np.zeros((n, 3)), mass, 0.0, buf, 1)
-    tr.grid_dilatation(buf, grid_div, SHAPE, -1)
+    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, np.zeros((n, 3)), C, np.zeros((n, 3)), mass, 0.0, buf, 1,
+                      *everything(x, buf))
+    tr.grid_dilatation(buf, grid_div, SHAPE, -1, 0, buf.shape[1])
     tr_ref, d_ref, _ = projection_reference(grid_v, x, mass)
     scale = np.abs(d_ref).max()
     np.testing.assert_allclose(grid_div, d_ref, rtol=0, atol=1e-12 * scale)
@@ -576,8 +588,8 @@ def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain(
         out = np.zeros(grid.n_nodes)
         k = len(xs)
         tr.g2p_kinematics(gv, grid.origin, dx, shape, xs, np.zeros((k, 3)), np.zeros((k, 3, 3)), np.zeros((k, 3)), ms,
-                          0.0, buf, 1)
-        tr.grid_dilatation(buf, out, shape, mirror_plane_index(grid, symmetric))
+                          0.0, buf, 1, *everything(xs, buf))
+        tr.grid_dilatation(buf, out, shape, mirror_plane_index(grid, symmetric), 0, buf.shape[1])
         return out
 
     d_h = project(half_grid, x, mass, True)
@@ -589,3 +601,86 @@ def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain(
         checked += 1
         assert d_h[i] == pytest.approx(d_f[j], rel=1e-9, abs=1e-9 * np.abs(d_f).max())
     assert checked > 100
+
+
+# ----------------------------------------------------------------------------- active zone (index ranges)
+def test_p2g_over_a_particle_range_is_the_scatter_of_those_particles_and_keeps_other_nodes():
+    """The active zone's particle range [p_lo, p_hi) scatters exactly those particles; nodes outside
+    the node range [n_lo, n_hi) are neither zeroed nor summed."""
+    rng, x, v, vol0, J, mass = random_particles(n=400, seed=21)
+    n = x.shape[0]
+    order = np.argsort(x[:, 0])  # x-major, as the solver seeds them
+    x, v, vol0, J, mass = x[order], v[order], vol0[order], J[order], mass[order]
+    C, stress = rng.normal(0.0, 50.0, (n, 3, 3)), random_sym_stress(rng, n)
+    n_nodes = int(np.prod(SHAPE))
+    p_lo, p_hi = 100, 300
+    for n_chunks in (1, 2):
+        ranged = np.full((n_chunks, n_nodes, 7), 7.0)
+        tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, ranged, p_lo, p_hi, 0, n_nodes)
+        sub = tr.allocate_grid_buffers(1, n_nodes)
+        sl = slice(p_lo, p_hi)
+        tr.p2g(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl], ORIGIN, DX, 1e-8, SHAPE, sub,
+               *everything(x[sl], sub))
+        np.testing.assert_allclose(ranged.sum(0), sub[0], rtol=1e-12, atol=1e-12 * np.abs(sub).max())
+    slab = SHAPE[1] * SHAPE[2]
+    kept = np.full((1, n_nodes, 7), 7.0)
+    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, kept, 0, 0, 4 * slab, 9 * slab)
+    assert np.all(kept[0, 4 * slab:9 * slab] == 0.0)  # the range was zeroed, no particle scattered
+    assert np.all(kept[0, :4 * slab] == 7.0) and np.all(kept[0, 9 * slab:] == 7.0)
+
+
+def test_grid_update_clamps_the_frozen_slabs_and_leaves_nodes_outside_its_range():
+    """Nodes of x index outside [i_free_lo, i_free_hi] hold zero velocity (the frozen material), the
+    others are the plain update; nodes outside [n_lo, n_hi) are not written."""
+    rng = np.random.default_rng(22)
+    n_nodes = int(np.prod(SHAPE))
+    slab = int(SHAPE[1] * SHAPE[2])
+    buf = np.zeros((2, n_nodes, 7))
+    buf[:, :, 0] = rng.uniform(0.1, 1.0, (2, n_nodes))
+    buf[:, :, 1:] = rng.normal(0.0, 1.0, (2, n_nodes, 6))
+    flags = np.full(n_nodes, FREE, dtype=np.int8)
+    full_m, full_v = np.zeros(n_nodes), np.zeros((n_nodes, 6))
+    tr.grid_update(buf, flags, full_m, full_v, SHAPE, -1, *all_nodes(buf, SHAPE))
+    grid_m, grid_v = np.full(n_nodes, -1.0), np.full((n_nodes, 6), 99.0)
+    n_lo, n_hi, i_free_lo, i_free_hi = 3 * slab, 12 * slab, 5, 9
+    tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1, n_lo, n_hi, i_free_lo, i_free_hi)
+    i = np.arange(n_nodes) // slab
+    inside = (np.arange(n_nodes) >= n_lo) & (np.arange(n_nodes) < n_hi)
+    free = inside & (i >= i_free_lo) & (i <= i_free_hi)
+    clamped = inside & ~free
+    assert clamped.any() and free.any()
+    np.testing.assert_array_equal(grid_m[~inside], -1.0)
+    np.testing.assert_array_equal(grid_v[~inside], 99.0)
+    np.testing.assert_array_equal(grid_m[inside], full_m[inside])
+    np.testing.assert_array_equal(grid_v[free], full_v[free])
+    np.testing.assert_array_equal(grid_v[clamped, :3], 0.0)
+    np.testing.assert_array_equal(grid_v[clamped, 3:], full_v[clamped, 3:])  # FLIP's old velocity is kept
+
+
+def test_freeze_particles_stops_them_and_counts_their_energies():
+    rng, x, v, vol0, J, mass = random_particles(n=50, seed=23)
+    n = x.shape[0]
+    table = pack_materials([rigid_plastic("coat", 450e6, coating=True), rigid_plastic("sub", 900e6, coating=False)])
+    mat_a = rng.integers(0, 2, n).astype(np.int32)
+    mat_b = np.ones(n, dtype=np.int32)
+    frac = rng.uniform(0.2, 1.0, n)
+    stress = random_sym_stress(rng, n)
+    C, v_grid = rng.normal(0.0, 1.0, (n, 3, 3)), rng.normal(0.0, 1.0, (n, 3))
+    v0, C0, v_grid0 = v.copy(), C.copy(), v_grid.copy()
+    elastic, kinetic = tr.freeze_particles(10, 30, v, C, v_grid, stress, J, vol0, mass, mat_a, mat_b, frac, table)
+    sl = slice(10, 30)
+    assert kinetic == pytest.approx(0.5 * np.sum(mass[sl, None] * v0[sl] ** 2), rel=1e-13)
+    # the elastic energy density of an isotropic solid: p^2 / 2K + s:s / 4G, moduli mixed by volume
+    K = frac * table[mat_a, I_K] + (1 - frac) * table[mat_b, I_K]
+    G = frac * table[mat_a, I_G] + (1 - frac) * table[mat_b, I_G]
+    p = stress[:, :3].mean(axis=1)
+    dev = stress.copy()
+    dev[:, :3] -= p[:, None]
+    ss = np.sum(dev[:, :3] ** 2, axis=1) + 2 * np.sum(dev[:, 3:] ** 2, axis=1)
+    density = p**2 / (2 * K) + ss / (4 * G)
+    assert elastic == pytest.approx(np.sum((density * vol0 * J)[sl]), rel=1e-12)
+    assert np.all(v[sl] == 0.0) and np.all(C[sl] == 0.0) and np.all(v_grid[sl] == 0.0)
+    rest = np.r_[0:10, 30:n]
+    np.testing.assert_array_equal(v[rest], v0[rest])
+    np.testing.assert_array_equal(C[rest], C0[rest])
+    np.testing.assert_array_equal(v_grid[rest], v_grid0[rest])

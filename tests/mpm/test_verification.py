@@ -126,6 +126,6 @@ def test_energy_balance(half_and_full):
     for ds in half_and_full:
         work = float(ds.external_work[-1])
         parts = sum(float(ds[k][-1]) for k in ("plastic_work", "elastic_energy", "kinetic_energy",
-                                               "interface_dissipation", "contact_impact_loss"))
+                                               "interface_dissipation", "contact_impact_loss", "frozen_kinetic_loss"))
         assert work > 0
         assert parts == pytest.approx(work, rel=0.10)

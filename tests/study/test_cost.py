@@ -8,8 +8,9 @@ from pathlib import Path
 import pytest
 
 from plough.mpm import solver
+from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
-from plough.study.cost import estimate
+from plough.study.cost import active_fraction, estimate
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -21,3 +22,25 @@ def test_particle_estimate_follows_the_seeding(example, graded):
     scene = replace(scene, discretisation=replace(scene.discretisation, graded=graded))
     state, _ = solver.init(scene, n_chunks=1)
     assert estimate(scene).particles == pytest.approx(state.particles.n, rel=0.03)
+
+
+def test_active_fraction_of_simple_runs():
+    # a zone wider than the block covers all of it
+    assert active_fraction(0.5, 0.2, 1.0, 2.0, 100, 100) == 1.0
+    # a zone inside the block all along covers 2 w / L
+    assert active_fraction(0.3, 0.4, 1.0, 0.1, 50, 500) == pytest.approx(0.2, rel=1e-12)
+    # clipped at the start: half the zone while in place, then sliding out of the clip
+    f = active_fraction(0.0, 0.2, 1.0, 0.1, 1000, 0, samples=10)
+    assert f == pytest.approx(0.1, rel=1e-12)
+
+
+def test_active_fraction_follows_the_solver():
+    """The estimate's share of particle-steps against the solver's count on a coarse reference run."""
+    scene = Scene.from_yaml(ROOT / "examples" / "uncoated_rigid_plastic.yaml").with_sized_domain()
+    scene = replace(scene, discretisation=replace(scene.discretisation, particle_size_m=20e-6,
+                                                  active_zone_contact_radii=4.0))
+    ds = simulate(scene, progress=False, threads=1)
+    est = estimate(scene)
+    assert est.active_fraction == pytest.approx(ds.attrs["cost_active_fraction"], rel=0.05)
+    assert est.particle_steps == pytest.approx(ds.attrs["cost_particle_steps"], rel=0.1)
+    assert est.active_fraction < 0.8

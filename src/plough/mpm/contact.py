@@ -94,12 +94,12 @@ def _pick(k, v0, v1, v2):
 
 @njit(cache=True)
 def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near, origin,
-                           dx, shape, centre, radius, mirror_j0, cbuf):
+                           dx, shape, centre, radius, mirror_j0, cbuf, p_lo, p_hi):
     """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
     sphere onto nearby nodes.
 
     Reads particle x, stress, mass, vol0, J, eps_p, temperature, materials and ``near`` (set by
-    g2p). For nodes within one cell of the sphere surface (or inside it) writes
+    g2p) of the active particles p_lo <= p < p_hi. For nodes within one cell of the sphere surface (or inside it) writes
     cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m,
     cbuf[node, 8] = max(cbuf[node, 8], dx - gap) over its particles (gap = distance from the
     particle's face, half a particle size from its centre, to the sphere surface) and
@@ -114,7 +114,7 @@ def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, 
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
     reach2 = (radius + dx) * (radius + dx)
-    for p in range(x.shape[0]):
+    for p in range(p_lo, p_hi):
         if near[p] == 0:
             continue
         q0 = x[p, 0] - centre[0]

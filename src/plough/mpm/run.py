@@ -54,9 +54,10 @@ class _Recorder:
             "particle_penetration": pen, "contact_area_xy": k * float(w.contact_out[contact.OUT_AREA_XY]),
             "material_top": float(s.particles.x[:, 2].max()),
             "external_work": k * w.external_work, "plastic_work": k * w.plastic_work,
-            "elastic_energy": k * float(acc[:, transfers.ACC_ELASTIC].sum()),
+            "elastic_energy": k * (float(acc[:, transfers.ACC_ELASTIC].sum()) + s.zone.frozen_elastic),
             "kinetic_energy": k * float(acc[:, transfers.ACC_KINETIC].sum()),
             "interface_dissipation": k * w.interface_dissipation, "contact_impact_loss": k * w.contact_impact_loss,
+            "frozen_kinetic_loss": k * s.zone.frozen_kinetic_loss,
             "heat": k * w.heat, "time": s.time,
         })
         self.slid.append(s.sphere.slid_m if s.sphere.phase in ("slide", "done") else 0.0)
@@ -125,9 +126,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     bar = _progress(scene, enabled=progress)
     stopper = SteadyStop(scene) if scene.sliding.stop_when_steady else None
     slid_distance = scene.sliding.distance_m
+    active_particle_steps = 0
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
+            active_particle_steps += state.zone.p_hi - state.zone.p_lo
             rec.add(state, const)
             if stopper is not None and state.sphere.phase == "slide" and stopper.steady(rec, state.sphere.slid_m):
                 slid_distance = state.sphere.slid_m
@@ -154,8 +157,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     wall = time.perf_counter() - wall0
     series, slid = rec.series()
     n = state.particles.n
+    # particle-steps count the particles a step worked on (all of them without an active zone)
     cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
-            "dt_s": const.dt, "particle_steps_per_s": n * state.step / wall, "threads": numba.get_num_threads()}
+            "dt_s": const.dt, "particle_steps": active_particle_steps,
+            "active_fraction": active_particle_steps / max(n * state.step, 1),
+            "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads()}
     ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
                           rec.max_penetration, coating_row, slid_distance_m=slid_distance)
     warn_if_unsteady(ds, scene.name)

@@ -216,6 +216,10 @@ class Sliding:
 #: smallest fine zone of graded particles, in expected contact radii: the sphere touches only h particles
 FINE_ZONE_MIN_CONTACT_RADII = 1.0
 
+#: smallest active zone, in expected contact radii behind and ahead of the sphere: the plastic zone
+#: of a sliding sphere reaches about 2 a, and the sized block's end margins are at least 2 a too
+ACTIVE_ZONE_MIN_CONTACT_RADII = 2.0
+
 #: how J and the pressure see the dilatation rate (see Discretisation)
 DILATATION_MODES = ("projected", "local")
 
@@ -242,6 +246,14 @@ class Discretisation:
     length); outside it
     each complete 2 x 2 x 2 group of lattice particles is one particle of size 2 h (one per cell
     at two particles per cell). The grid stays uniform. Off by default (README, "Graded particles").
+
+    ``active_zone_contact_radii``: when set, only the particles that started within this many
+    expected contact radii behind or ahead of the sphere's centre (along the slide) are updated;
+    the rest are frozen (they keep their position and stress, and the grid nodes in their region
+    hold zero velocity, so the active material is clamped there as at the block's curved surface).
+    The zone moves with the sphere and a particle that leaves it behind stays frozen. The sized
+    block's end margins are the same clamp at the start and the end of the slide; this keeps it
+    throughout. None (default) updates every particle (README, "Active zone").
     """
 
     particle_size_m: float = 10e-6
@@ -252,6 +264,7 @@ class Discretisation:
     dilatation: str = "projected"
     graded: bool = False
     fine_zone_contact_radii: float = 1.5
+    active_zone_contact_radii: float | None = None
 
     def __post_init__(self) -> None:
         _finite_positive("discretisation", "particle_size_m", self.particle_size_m, "m")
@@ -273,6 +286,12 @@ class Discretisation:
             raise ValueError(f"discretisation.fine_zone_contact_radii = {k!r} is outside the allowed range "
                              f"[{FINE_ZONE_MIN_CONTACT_RADII:g}, inf): the contact (one expected contact radius) "
                              "must lie in the fine zone")
+        k = self.active_zone_contact_radii
+        if k is not None and not (isinstance(k, int | float) and not isinstance(k, bool) and math.isfinite(k)
+                                  and k >= ACTIVE_ZONE_MIN_CONTACT_RADII):
+            raise ValueError(f"discretisation.active_zone_contact_radii = {k!r} is outside the allowed range "
+                             f"[{ACTIVE_ZONE_MIN_CONTACT_RADII:g}, inf) or null: the plastic zone (about 2 expected "
+                             "contact radii) must lie in the active zone")
         if self.graded and self.particles_per_cell < 2:
             raise ValueError("discretisation.graded = true needs discretisation.particles_per_cell >= 2 (got "
                              f"{self.particles_per_cell}): the far-field particles of size 2 h must not exceed a cell")
@@ -569,13 +588,14 @@ class Scene:
 
     def with_paper_settings(self) -> Scene:
         """The paper's numerical setup as a named preset: the fixed 0.2 mm x 1 mm half cylinder
-        (mirror plane on), a 0.6 mm slide at 0.1 m/s, mass scaling 1e6, uniform particles, steady
-        window the last half of the slide. Physics (layers, load, sphere, interface) and the
-        particle size, CFL number and transfer are kept. ``benchmarks/work_precision.py`` runs it
-        beside the defaults."""
+        (mirror plane on), a 0.6 mm slide at 0.1 m/s, mass scaling 1e6, uniform particles, every
+        particle updated on every step (no active zone), steady window the last half of the slide.
+        Physics (layers, load, sphere, interface) and the particle size, CFL number and transfer are
+        kept. ``benchmarks/work_precision.py`` runs it beside the defaults."""
         return replace(self, domain=replace(PAPER_DOMAIN, headroom_m=self.domain.headroom_m),
                        sliding=replace(self.sliding, distance_m=600e-6, speed_m_s=0.1, stop_when_steady=False),
-                       discretisation=replace(self.discretisation, mass_scaling=1e6, graded=False),
+                       discretisation=replace(self.discretisation, mass_scaling=1e6, graded=False,
+                                              active_zone_contact_radii=None),
                        outputs=replace(self.outputs, steady_window=(0.5, 1.0)))
 
     def with_(self, **changes: Any) -> Scene:

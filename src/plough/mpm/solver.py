@@ -15,6 +15,11 @@ One step (model.md section 2):
 
 The time step is dt = CFL dx / c with c = sqrt((K + 4G/3) / (ms rho)) the mass-scaled elastic
 wave speed.
+
+With ``discretisation.active_zone_contact_radii`` the step works only on the particles that
+started within that many expected contact radii of the sphere's centre along x, and on the grid
+slabs around them (:class:`ActiveZone`): particles and nodes are stored x-major, so both are
+index ranges; the material beyond is frozen and clamps the active part.
 """
 
 from __future__ import annotations
@@ -46,6 +51,9 @@ CONTROL_STEPS = 40.0
 STIFFNESS_FACTOR = 1.0
 SETTLE_STEPS = 300
 INTEGRAL_STEPS = 100.0
+#: grid slabs worked on beyond each clamp face of the active zone, so that the stencils of the
+#: active particles (displaced by a few um at most) stay on nodes the step updates
+ZONE_PAD_CELLS = 3
 
 
 class SimulationError(RuntimeError):
@@ -93,6 +101,28 @@ class Constants:
     steps_slide: int
     shape: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.int64))
     mirror_j0: int = -1  # index of the node plane y = 0 with symmetry, -1 without
+    zone_half_width: float = 0.0  # m, active zone behind and ahead of the sphere centre; 0: every particle
+    zone_x0: np.ndarray = field(default_factory=lambda: np.zeros(0))  # initial x of the particles, ascending
+    block_length: float = 0.0  # m
+
+
+@dataclass
+class ActiveZone:
+    """The particles [p_lo, p_hi) and flat grid nodes [n_lo, n_hi) a step works on.
+
+    Nodes of x index below ``i_free_lo`` or above ``i_free_hi`` lie in frozen material and hold
+    zero velocity. Both ranges only move forward: a particle the zone has left stays frozen,
+    with the elastic energy it keeps and the kinetic energy it lost counted here.
+    """
+
+    p_lo: int
+    p_hi: int
+    n_lo: int
+    n_hi: int
+    i_free_lo: int
+    i_free_hi: int
+    frozen_elastic: float = 0.0  # J
+    frozen_kinetic_loss: float = 0.0  # J
 
 
 @dataclass
@@ -122,6 +152,7 @@ class State:
     particles: Particles
     sphere: SphereState
     work: Work
+    zone: ActiveZone
     step: int = 0
     time: float = 0.0
 
@@ -188,8 +219,20 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
         L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
     )
+    if disc.active_zone_contact_radii is not None:
+        const.zone_half_width = disc.active_zone_contact_radii * a_exp
+        const.zone_x0 = particles.x[:, 0].copy()
+        const.block_length = scene.domain.length_m
+        if np.any(np.diff(const.zone_x0) < 0.0):
+            raise AssertionError("particles are not seeded x-major: the active zone needs them sorted along x")
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
-    return State(particles=particles, sphere=sphere, work=work), const
+    if const.zone_half_width > 0.0:  # empty ranges, opened by the first update
+        zone = ActiveZone(p_lo=0, p_hi=0, n_lo=0, n_hi=0, i_free_lo=-1, i_free_hi=-1)
+    else:
+        zone = ActiveZone(p_lo=0, p_hi=particles.n, n_lo=0, n_hi=grid.n_nodes, i_free_lo=0, i_free_hi=grid.shape[0])
+    state = State(particles=particles, sphere=sphere, work=work, zone=zone)
+    update_active_zone(state, const)
+    return state, const
 
 
 def contact_stiffness(scene: Scene, contact_radius: float) -> float:
@@ -207,32 +250,70 @@ def contact_stiffness(scene: Scene, contact_radius: float) -> float:
 # ----------------------------------------------------------------------------- one step
 def step(s: State, c: Constants) -> None:
     """Advance the state by one time step dt."""
-    p, w, sph = s.particles, s.work, s.sphere
+    p, w, sph, z = s.particles, s.work, s.sphere, s.zone
     g = c.grid
-    transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf)
-    transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v, c.shape, c.mirror_j0)
+    update_active_zone(s, c)
+    transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf,
+                  z.p_lo, z.p_hi, z.n_lo, z.n_hi)
+    transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v, c.shape, c.mirror_j0, z.n_lo, z.n_hi,
+                          z.i_free_lo, z.i_free_hi)
     contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
                                    p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
-                                   c.mirror_j0, w.cbuf)
+                                   c.mirror_j0, w.cbuf, z.p_lo, z.p_hi)
     contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, w.last_push, s.step, c.contact_hold_steps, g.origin,
                            g.dx, c.shape, sph.centre, c.sphere_radius, sph.velocity, c.dt, c.interface_model,
                            c.interface_params, w.contact_out)
     if c.mirror_j0 >= 0:
-        transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0)
+        transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0, z.n_lo, z.n_hi)
     move_sphere(sph, c)
     transfers.g2p_kinematics(w.grid_v, g.origin, g.dx, c.shape, p.x, p.v, p.C, w.v_grid, p.mass, c.flip, w.grid_buf,
-                             c.project_dilatation)
+                             c.project_dilatation, z.p_lo, z.p_hi, z.n_lo, z.n_hi)
     if c.project_dilatation:
-        transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0)
+        transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0, z.n_lo, z.n_hi)
     transfers.g2p_update(g.origin, g.dx, c.dt, c.shape, p.x, p.v, w.v_grid, p.C, p.stress, p.J, p.vol0, p.mass,
                          p.eps_p, p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney,
                          sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, w.grid_div,
-                         c.project_dilatation, w.L_buf)
+                         c.project_dilatation, w.L_buf, z.p_lo, z.p_hi)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
     s.step += 1
     s.time += c.dt
+
+
+def update_active_zone(s: State, c: Constants) -> None:
+    """Move the active zone with the sphere: freeze the particles it leaves, retire the grid slabs.
+
+    The zone holds the particles whose initial x lies within ``zone_half_width`` of the sphere's
+    centre; the clamp faces sit at the zone's ends, except where the zone reaches past the
+    block's ends (the block's own free end faces stay free). Retired nodes get zero mass and
+    velocity, so a particle that strays onto them is held as by the clamp.
+    """
+    if c.zone_half_width <= 0.0:
+        return
+    z, w, p = s.zone, s.work, s.particles
+    g = c.grid
+    nx, ny, nz = g.shape
+    lo_x = s.sphere.centre[0] - c.zone_half_width
+    hi_x = s.sphere.centre[0] + c.zone_half_width
+    p_lo = max(z.p_lo, int(np.searchsorted(c.zone_x0, lo_x, side="left")))
+    p_hi = max(z.p_hi, int(np.searchsorted(c.zone_x0, hi_x, side="right")))
+    if p_lo > z.p_lo:
+        elastic, kinetic = transfers.freeze_particles(z.p_lo, p_lo, p.v, p.C, w.v_grid, p.stress, p.J, p.vol0, p.mass,
+                                                      p.mat_a, p.mat_b, p.frac_a, c.table)
+        z.frozen_elastic += elastic
+        z.frozen_kinetic_loss += kinetic
+    i_free_lo = math.ceil((lo_x - g.origin[0]) / g.dx) if lo_x > 0.0 else 0
+    i_free_hi = math.floor((hi_x - g.origin[0]) / g.dx) if hi_x < c.block_length else nx
+    slab = ny * nz
+    n_lo = max(z.n_lo, max(i_free_lo - ZONE_PAD_CELLS, 0) * slab)
+    n_hi = max(z.n_hi, min(i_free_hi + ZONE_PAD_CELLS + 1, nx) * slab)
+    if n_lo > z.n_lo:
+        w.grid_m[z.n_lo:n_lo] = 0.0
+        w.grid_v[z.n_lo:n_lo] = 0.0
+        w.grid_div[z.n_lo:n_lo] = 0.0
+    z.p_lo, z.p_hi, z.n_lo, z.n_hi = p_lo, p_hi, n_lo, n_hi
+    z.i_free_lo, z.i_free_hi = max(z.i_free_lo, i_free_lo), max(z.i_free_hi, i_free_hi)
 
 
 def reaction_z(w: Work) -> float:

@@ -62,22 +62,23 @@ BAD_NONE, BAD_LEFT_GRID, BAD_J, BAD_NONFINITE = 0, 1, 2, 3
 
 
 @njit(cache=True, parallel=True)
-def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf):
+def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf, p_lo, p_hi, n_lo, n_hi):
     """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
 
-    Reads x, v, C, stress, vol0, J, mass (particles). Writes grid_buf[c, node, 0:7] = (mass,
-    momentum x, y, z, and the internal-force impulse x, y, z already in that momentum) of chunk
-    c, zeroing it first. Race-free: chunk c owns grid_buf[c].
+    Reads x, v, C, stress, vol0, J, mass of the active particles p_lo <= p < p_hi. Writes
+    grid_buf[c, node, 0:7] = (mass, momentum x, y, z, and the internal-force impulse x, y, z
+    already in that momentum) of chunk c, zeroing the active nodes n_lo <= node < n_hi first.
+    Race-free: chunk c owns grid_buf[c].
     """
-    n = x.shape[0]
+    n = p_hi - p_lo
     n_chunks = grid_buf.shape[0]
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
         buf = grid_buf[c]
-        buf[:, :] = 0.0
-        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
+        buf[n_lo:n_hi, :] = 0.0
+        for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             m = mass[p]
             k_stress = -dt * vol0[p] * J[p] * dinv
             s = stress[p]
@@ -131,14 +132,16 @@ def _mirror_partner(node, ny, nz, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
+def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0, n_lo, n_hi, i_free_lo, i_free_hi):
     """Sum the chunk copies into nodal mass and velocity and apply the boundary conditions.
 
     Reads grid_buf (P2G output), flags (FREE / FIXED / MIRROR / GHOST), the grid shape and the
-    index ``mirror_j0`` of the node plane y = 0 (-1 without symmetry). Writes grid_m[node],
-    grid_v[node, 0:3] (velocity at the end of the step before contact) and grid_v[node, 3:6]
-    (velocity before the internal force, for the FLIP increment). Each node is owned by
-    one iteration and only reads the buffers, so the reduction is race-free.
+    index ``mirror_j0`` of the node plane y = 0 (-1 without symmetry), for the active nodes
+    n_lo <= node < n_hi. Writes their grid_m[node], grid_v[node, 0:3] (velocity at the end of
+    the step before contact) and grid_v[node, 3:6] (velocity before the internal force, for the
+    FLIP increment). Nodes of x index outside [i_free_lo, i_free_hi] lie in the frozen material
+    beyond the active zone and hold zero velocity, as FIXED nodes do. Each node is owned by one
+    iteration and only reads the buffers, so the reduction is race-free.
 
     Mirror symmetry is exact, not just v_y = 0 on the plane: a node at y = +j dx also receives
     what the mirror images of the particles would give it, i.e. the contributions its ghost at
@@ -148,7 +151,7 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
     """
     n_chunks = grid_buf.shape[0]
     ny, nz = shape[1], shape[2]
-    for node in prange(grid_m.shape[0]):
+    for node in prange(n_lo, n_hi):
         m = 0.0
         p0 = 0.0
         p1 = 0.0
@@ -183,7 +186,8 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
             grid_v[node, 3] = 0.0
             grid_v[node, 4] = 0.0
             grid_v[node, 5] = 0.0
-        if m <= 0.0 or flags[node] == FIXED:
+        i = node // (ny * nz)
+        if m <= 0.0 or flags[node] == FIXED or i < i_free_lo or i > i_free_hi:
             grid_v[node, 0] = 0.0
             grid_v[node, 1] = 0.0
             grid_v[node, 2] = 0.0
@@ -194,13 +198,14 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def mirror_ghosts(grid_v, flags, shape, mirror_j0):
+def mirror_ghosts(grid_v, flags, shape, mirror_j0, n_lo, n_hi):
     """Ghost nodes (y < 0) take the mirror image of their partner's velocity after contact.
 
-    Reads grid_v of nodes with y > 0; writes grid_v of GHOST nodes (each written once).
+    Reads grid_v of nodes with y > 0; writes grid_v of the GHOST nodes among n_lo <= node < n_hi
+    (each written once; a partner lies in its ghost's x slab, so in the same range).
     """
     ny, nz = shape[1], shape[2]
-    for node in prange(grid_v.shape[0]):
+    for node in prange(n_lo, n_hi):
         if flags[node] != GHOST:
             continue
         j = (node // nz) % ny
@@ -214,17 +219,18 @@ def mirror_ghosts(grid_v, flags, shape, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def grid_dilatation(grid_buf, grid_div, shape, mirror_j0):
+def grid_dilatation(grid_buf, grid_div, shape, mirror_j0, n_lo, n_hi):
     """Nodal dilatation rate d_i = (sum w m d) / m_i from the chunk copies of the ``g2p_kinematics`` scatter.
 
-    Reads grid_buf[:, :, 0:2]; writes grid_div[node] (0 where no mass). With the mirror plane a
+    Reads grid_buf[:, node, 0:2] of the active nodes n_lo <= node < n_hi; writes their
+    grid_div[node] (0 where no mass). With the mirror plane a
     node also sums its ghost's contributions (the dilatation is even in y), so ghost and partner
     hold the same value and the half domain projects like the full one. Each node is owned by one
     iteration: race-free.
     """
     n_chunks = grid_buf.shape[0]
     ny, nz = shape[1], shape[2]
-    for node in prange(grid_div.shape[0]):
+    for node in prange(n_lo, n_hi):
         m = 0.0
         t = 0.0
         for c in range(n_chunks):
@@ -239,17 +245,19 @@ def grid_dilatation(grid_buf, grid_div, shape, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_buf, scatter_dilatation):
+def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_buf, scatter_dilatation, p_lo, p_hi,
+                   n_lo, n_hi):
     """Gather the particle velocities and velocity gradients; scatter the dilatation for its projection.
 
-    Reads grid_v (0:3 new, 3:6 before the internal force), particle x, v (FLIP share ``flip``),
-    mass. Writes particle v (the blended update), C (= L_p, the APIC velocity gradient) and v_grid
-    (sum_i w v_i, the velocity the particle is advected with). If ``scatter_dilatation`` is 1 also
-    writes grid_buf[c, node, 0] = sum w m and grid_buf[c, node, 1] = sum w m tr L over chunk c's
-    particles (zeroing those two channels first; the P2G content is no longer needed), for
+    Reads grid_v (0:3 new, 3:6 before the internal force), x, v (FLIP share ``flip``) and mass
+    of the active particles p_lo <= p < p_hi. Writes their v (the blended update), C (= L_p, the
+    APIC velocity gradient) and v_grid (sum_i w v_i, the velocity the particle is advected with).
+    If ``scatter_dilatation`` is 1 also writes grid_buf[c, node, 0] = sum w m and
+    grid_buf[c, node, 1] = sum w m tr L over chunk c's particles (zeroing those two channels of
+    the active nodes n_lo <= node < n_hi first; the P2G content is no longer needed), for
     ``grid_dilatation``. Race-free: particle p writes only its own entries, chunk c only grid_buf[c].
     """
-    n = x.shape[0]
+    n = p_hi - p_lo
     n_chunks = grid_buf.shape[0]
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
@@ -257,8 +265,8 @@ def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_
     for c in prange(n_chunks):
         buf = grid_buf[c]
         if scatter_dilatation:
-            buf[:, 0:2] = 0.0
-        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
+            buf[n_lo:n_hi, 0:2] = 0.0
+        for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             gx = (x[p, 0] - origin[0]) * inv_dx
             gy = (x[p, 1] - origin[1]) * inv_dx
             gz = (x[p, 2] - origin[2]) * inv_dx
@@ -342,10 +350,11 @@ def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_
 @njit(cache=True, parallel=True)
 def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, mat_a, mat_b,
                frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo, grid_hi,
-               grid_div, project, L_buf):
+               grid_div, project, L_buf, p_lo, p_hi):
     """Update the stress (eq. 6.1-6.2), advect, and check the particle state.
 
-    Reads particle v, v_grid and C (from ``g2p_kinematics``), the sphere (centre sphere_c after this
+    Works on the active particles p_lo <= p < p_hi only. Reads particle v, v_grid and C (from
+    ``g2p_kinematics``), the sphere (centre sphere_c after this
     step, radius sphere_r) and, if ``project`` is 1, the projected nodal dilatation grid_div
     (``grid_dilatation``): J and the pressure then follow L_bar = C + (sum w d_i - tr C) I / 3,
     formed in the chunk's scratch L_buf[c]; with ``project`` 0 they follow C (grid_div and L_buf
@@ -355,7 +364,7 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
     sphere, worst instability code and the particle showing it). Each particle writes only its own
     entries.
     """
-    n = x.shape[0]
+    n = p_hi - p_lo
     n_chunks = acc.shape[0]
     ny, nz = shape[1], shape[2]
     inv_dx = 1.0 / dx
@@ -367,7 +376,7 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
         pen_max = -1e300
         bad = BAD_NONE
         bad_p = -1
-        for p in range(c * n // n_chunks, (c + 1) * n // n_chunks):
+        for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             Cp = C[p]
             L = Cp
             if project:
@@ -458,6 +467,28 @@ def _det_i_plus(dt, L):
     a21 = dt * L[2, 1]
     a22 = 1.0 + dt * L[2, 2]
     return a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) + a02 * (a10 * a21 - a11 * a20)
+
+
+@njit(cache=True)
+def freeze_particles(p_from, p_to, v, C, v_grid, stress, J, vol0, mass, mat_a, mat_b, frac_a, table):
+    """Freeze the particles p_from <= p < p_to as the active zone leaves them behind.
+
+    Reads their stress, J, vol0, mass and materials; zeroes their v, C and v_grid (a frozen
+    particle is at rest and keeps its position and stress). Returns (elastic energy they keep,
+    kinetic energy they lose), in J. Serial: a few particles per step.
+    """
+    elastic = 0.0
+    kinetic = 0.0
+    for p in range(p_from, p_to):
+        K, G = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
+        elastic += elastic_energy_density(stress, p, K, G) * vol0[p] * J[p]
+        kinetic += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
+        for d in range(3):
+            v[p, d] = 0.0
+            v_grid[p, d] = 0.0
+            for e in range(3):
+                C[p, d, e] = 0.0
+    return elastic, kinetic
 
 
 def allocate_grid_buffers(n_chunks: int, n_nodes: int) -> np.ndarray:

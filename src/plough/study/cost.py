@@ -6,7 +6,10 @@ particles fill the half cylinder below z = 0 (a quarter with the mirror plane) o
 (graded scenes: times the count ratio of one slice of the block);
 dt = CFL * dx / (c + 2 v) with c the mass-scaled P-wave speed of the stiffest layer; the sphere
 presses at
-``press_speed_fraction * v`` to about the expected ploughing depth, settles, then slides.
+``press_speed_fraction * v`` to about the expected ploughing depth, settles, then slides. With an
+active zone (``discretisation.active_zone_contact_radii``) a step works on the particles within
+the zone only: ``active_fraction`` is the mean share of the block's length the zone covers over
+the run's steps (the particles are spread evenly along x).
 """
 
 from __future__ import annotations
@@ -30,10 +33,12 @@ SETTLE_STEPS = 300
 class RunCost:
     particles: int
     steps: int
+    active_fraction: float = 1.0  # mean share of the particles a step works on
 
     @property
     def particle_steps(self) -> float:
-        return float(self.particles) * self.steps
+        """Particle updates of the run: what its wall time follows."""
+        return float(self.particles) * self.steps * self.active_fraction
 
     @property
     def memory_mb(self) -> int:
@@ -60,7 +65,24 @@ def estimate(scene: Scene) -> RunCost:
     _, dp = scene.expected_contact()
     press = dp / (scene.sliding.press_speed_fraction * v) / dt
     slide = scene.sliding.distance_m / v / dt
-    return RunCost(particles=particles, steps=int(press + SETTLE_STEPS + slide))
+    fraction = 1.0
+    k = scene.discretisation.active_zone_contact_radii
+    if k is not None:
+        a, _ = scene.expected_contact()
+        fraction = active_fraction(scene.start_x_m, scene.sliding.distance_m, dom.length_m, k * a,
+                                   press + SETTLE_STEPS, slide)
+    return RunCost(particles=particles, steps=int(press + SETTLE_STEPS + slide), active_fraction=fraction)
+
+
+def active_fraction(start_m: float, slide_m: float, length_m: float, half_width_m: float, steps_in_place: float,
+                    steps_sliding: float, samples: int = 400) -> float:
+    """Mean share of the block [0, length] inside the zone [x - w, x + w] over a run whose sphere
+    stays at ``start`` for ``steps_in_place`` steps and then moves evenly to ``start + slide``."""
+    def share(x: float) -> float:
+        return (min(x + half_width_m, length_m) - max(x - half_width_m, 0.0)) / length_m
+
+    sliding = sum(share(start_m + slide_m * (i + 0.5) / samples) for i in range(samples)) / samples
+    return (steps_in_place * share(start_m) + steps_sliding * sliding) / (steps_in_place + steps_sliding)
 
 
 #: Particle-steps per second per thread measured on the reference scene

@@ -224,6 +224,10 @@ def figure_runs(config: dict[str, Any], figure: str) -> list[str]:
 
 
 # ----------------------------------------------------------------------------- scenes
+def _optional_float(value: Any) -> float | None:
+    return None if value is None else float(value)
+
+
 def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
     """The complete scene of one run: the physical point at particle size h with the numerics."""
     h = float(h_um) * 1e-6
@@ -249,7 +253,8 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
                                       flip=float(numerics.get("flip", 1.0)),
                                       dilatation=str(numerics.get("dilatation", "projected")),
                                       graded=numerics.get("graded", False),
-                                      fine_zone_contact_radii=float(numerics.get("fine_zone_contact_radii", 1.5))),
+                                      fine_zone_contact_radii=float(numerics.get("fine_zone_contact_radii", 1.5)),
+                                      active_zone_contact_radii=_optional_float(numerics.get("active_zone_contact_radii"))),
         outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
                         records=int(numerics["records"]),
                         buried_profile_depth_m=float(numerics["buried_profile_depth_um"]) * 1e-6),
