@@ -15,6 +15,8 @@ shorter wall time. Scenes:
 - uncoated: examples/uncoated_rigid_plastic.yaml (H = 900 MPa, r = 0.2 mm, 3 N, f = 1), h = 10, 5 um;
 - real: examples/zinc_coated_steel.yaml (zinc t = 15 um on DX56, r = 0.5 mm, 22 N), h = 20, 10 um.
 
+``--zones`` adds, for each value, the graded run (first ``--k``) with an active zone of that
+many expected contact radii (``discretisation.active_zone_contact_radii``; README, *Active zone*).
 ``--paper`` adds the paper's numerical setup (``Scene.with_paper_settings()``: its fixed block,
 uniform particles) at each size, for the speed-up of the defaults against it at equal error.
 ``--sizes`` replaces the scenes' two sizes; ``--skip-uniform`` runs the graded cases only (the
@@ -42,10 +44,11 @@ SCENES = {"coated": ("coated_rigid_plastic.yaml", (10.0, 5.0)),
           "real": ("zinc_coated_steel.yaml", (20.0, 10.0))}
 
 
-def scene_at(example: str, h_um: float, k: float | str | None) -> Scene:
-    """Uniform (k None), graded with fine zone k, or the paper's settings (k "paper") at size h_um."""
+def scene_at(example: str, h_um: float, k: float | str | None, zone: float | None = None) -> Scene:
+    """Uniform (k None), graded with fine zone k, or the paper's settings (k "paper") at size h_um;
+    with an active zone of ``zone`` expected contact radii if given."""
     base = Scene.from_yaml(ROOT / "examples" / example)
-    disc = replace(base.discretisation, particle_size_m=h_um * 1e-6)
+    disc = replace(base.discretisation, particle_size_m=h_um * 1e-6, active_zone_contact_radii=zone)
     if k == "paper":
         return replace(base, discretisation=disc).with_paper_settings()
     if k is not None:
@@ -53,10 +56,11 @@ def scene_at(example: str, h_um: float, k: float | str | None) -> Scene:
     return replace(base, discretisation=disc).with_sized_domain()
 
 
-def label(k: float | str | None) -> str:
+def label(k: float | str | None, zone: float | None = None) -> str:
     if k == "paper":
         return "paper's settings"
-    return "uniform" if k is None else f"graded k={k:g}"
+    name = "uniform" if k is None else f"graded k={k:g}"
+    return name if zone is None else f"{name} zone {zone:g}"
 
 
 def summary(runs: dict) -> str:
@@ -87,6 +91,8 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--sizes", nargs="+", type=float, default=None, help="particle sizes, um")
     parser.add_argument("--paper", action="store_true", help="also the paper's numerical setup")
+    parser.add_argument("--zones", nargs="+", type=float, default=[], help="active zones (contact radii) added to "
+                        "the graded run of the first --k")
     parser.add_argument("--skip-uniform", action="store_true", help="graded runs only (e.g. at h = 2.5 um)")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "graded_particles.json")
     args = parser.parse_args()
@@ -97,10 +103,12 @@ def main() -> None:
         runs[name] = {}
         for h in args.sizes or sizes:
             runs[name][str(h)] = {}
-            for k in [*([] if args.skip_uniform else [None]), *args.k, *(["paper"] if args.paper else [])]:
-                row = run_scene(scene_at(example, h, k), args.threads)
-                runs[name][str(h)][label(k)] = row
-                print(f"{name} h = {h} um {label(k)}: {row['particles']:,} particles, {row['wall_s']:.1f} s, "
+            cases = [*([] if args.skip_uniform else [(None, None)]), *((k, None) for k in args.k),
+                     *((args.k[0], z) for z in args.zones), *([("paper", None)] if args.paper else [])]
+            for k, zone in cases:
+                row = run_scene(scene_at(example, h, k, zone), args.threads)
+                runs[name][str(h)][label(k, zone)] = row
+                print(f"{name} h = {h} um {label(k, zone)}: {row['particles']:,} particles, {row['wall_s']:.1f} s, "
                       f"mu {row['mu']:.4f}, mu_sh {row['mu_sh']:.4f}, dp {row['dp'] * 1e6:.2f} um", flush=True)
                 args.out.write_text(json.dumps({"threads": args.threads, "runs": runs}, indent=2) + "\n")
     print(summary(runs))

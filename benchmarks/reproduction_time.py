@@ -12,6 +12,10 @@ With ``numerics.graded`` on, the particle counts are the graded ones and the thr
 by the graded runs' particle-steps per second over the uniform runs' at the same scene and size
 (median over benchmarks/results/graded_particles.json, fine zone as configured): a graded run has
 fewer particles on the same grid, so the grid's share of a step grows.
+With ``numerics.active_zone_contact_radii`` set, each run's particle-steps are those its active
+zone works on (plough.study.cost), and the throughput is scaled by the zoned runs' particle-steps
+worked on per second over the same scenes' runs without a zone (median over
+benchmarks/results/active_zone.json, zone as configured).
 Writes benchmarks/results/reproduction_time.json and prints a Markdown table.
 """
 
@@ -47,11 +51,23 @@ def graded_throughput_ratio(path: Path, k: float) -> float:
     return statistics.median(ratios)
 
 
+def zone_throughput_ratio(path: Path, k: float) -> float:
+    """Median over scenes and sizes of (particle-steps worked on per second with zone k) / (without a zone)."""
+    runs = json.loads(path.read_text())["runs"]
+    ratios = [rows[f"zone {k:g}"]["active_fraction"] * rows["all"]["wall_s"] / rows[f"zone {k:g}"]["wall_s"]
+              for rows in runs.values() if f"zone {k:g}" in rows and "all" in rows]
+    if not ratios:
+        raise SystemExit(f"{path} has no run with active_zone_contact_radii = {k:g}: "
+                         "run benchmarks/active_zone.py first")
+    return statistics.median(ratios)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
     parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
     parser.add_argument("--graded-measured", default=str(ROOT / "benchmarks" / "results" / "graded_particles.json"))
+    parser.add_argument("--zone-measured", default=str(ROOT / "benchmarks" / "results" / "active_zone.json"))
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
     args = parser.parse_args()
     config = yaml.safe_load(Path(args.config).read_text())
@@ -64,6 +80,12 @@ def main() -> None:
         graded_factor = graded_throughput_ratio(Path(args.graded_measured), k)
         print(f"graded particles: throughput x {graded_factor:.3f} (graded over uniform, {args.graded_measured})")
         throughput *= graded_factor
+    zone_factor = 1.0
+    if numerics.get("active_zone_contact_radii") is not None:
+        zone_factor = zone_throughput_ratio(Path(args.zone_measured), float(numerics["active_zone_contact_radii"]))
+        print(f"active zone: throughput x {zone_factor:.3f} (particle-steps worked on per second, zoned over "
+              f"every particle, {args.zone_measured})")
+        throughput *= zone_factor
     by_size: dict[float, dict[str, float]] = {}
     with_skip = copy.deepcopy(config)
     with_skip["mpm"]["skip_finest_tolerance"] = 0.05
@@ -91,8 +113,10 @@ def main() -> None:
     print(f"| all | {sum(r['runs'] for r in by_size.values())} | | | {total / 3600:.1f} h ({total / 86400:.1f} days) |")
     print(f"\nwith skip_finest_tolerance, if all {len(skippable)} skippable finest runs are skipped: "
           f"{(total - skippable_s) / 3600:.1f} h (lower bound)")
-    out = {"config": args.config, "throughput_particle_steps_per_s": throughput, "graded_throughput_factor":
-           graded_factor, "graded": bool(numerics.get("graded", False)), "by_size_um": by_size,
+    out = {"config": args.config, "throughput_particle_steps_per_s": throughput,
+           "graded_throughput_factor": graded_factor, "active_zone_throughput_factor": zone_factor,
+           "active_zone_contact_radii": numerics.get("active_zone_contact_radii"),
+           "graded": bool(numerics.get("graded", False)), "by_size_um": by_size,
            "total_projected_s": total, "skippable_runs": len(skippable),
            "lower_bound_all_skipped_s": total - skippable_s}
     Path(args.out).write_text(json.dumps(out, indent=2) + "\n")

@@ -342,6 +342,18 @@ def test_graded_particles_reach_every_scene_of_the_matrix(config):
         assert d != before[rid]  # a changed scene: the workflow reruns it
 
 
+@pytest.mark.parametrize("zone", [None, 6.0])
+def test_active_zone_reaches_every_scene_of_the_matrix(config, zone):
+    """numerics.active_zone_contact_radii (null: every particle) goes into each run's discretisation."""
+    changed = copy.deepcopy(config)
+    changed["mpm"]["numerics"]["active_zone_contact_radii"] = zone
+    for d in matrix.all_runs(changed).values():
+        assert Scene.from_dict(d).discretisation.active_zone_contact_radii == zone
+    del changed["mpm"]["numerics"]["active_zone_contact_radii"]  # absent: every particle
+    for d in matrix.all_runs(changed).values():
+        assert Scene.from_dict(d).discretisation.active_zone_contact_radii is None
+
+
 @pytest.mark.parametrize("mode", ["sized", "fixed"])
 def test_grid_headroom_reaches_every_scene_of_the_matrix(config, mode):
     """numerics.domain.headroom_um is optional (automatic when absent) and, when given, sets every run's headroom."""
