@@ -5,7 +5,8 @@
 Runs the three reference scenes as the workflow does (block sized from the expected contact,
 graded particles with fine zone 1.5 contact radii, 2 threads; uncoated f = 1, coated f = 1 and
 coated f = 0.5, as in benchmarks/steadiness_check.py) with every particle updated and with an
-active zone of each given half-width (in expected contact radii), and records mu, dp, the
+active zone of each given half-width (in expected contact radii; at least 20 h,
+``Scene.active_zone_half_width_m``, whose value each row records in contact radii and in h), and records mu, dp, the
 steadiness values, the wall time and the share of particle-steps the zone worked on. The change a
 zone makes is to be read against the change from halving h (the discretisation error).
 Writes benchmarks/results/active_zone.json (after every run) and prints a Markdown table.
@@ -50,7 +51,12 @@ def main() -> None:
             rows = data["runs"].setdefault(label, {})
             for k in [None, *args.zones]:
                 disc = replace(scene.discretisation, active_zone_contact_radii=k)
-                row = run_scene(replace(scene, discretisation=disc), args.threads)
+                zoned = replace(scene, discretisation=disc)
+                row = run_scene(zoned, args.threads)
+                if k is not None:
+                    a, h = scene.expected_contact()[0], scene.discretisation.particle_size_m
+                    row["half_width_contact_radii"] = zoned.active_zone_half_width_m / a
+                    row["half_width_particles"] = zoned.active_zone_half_width_m / h
                 rows["all" if k is None else f"zone {k:g}"] = row
                 out.write_text(json.dumps(data, indent=1) + "\n")
                 ref = rows["all"]

@@ -178,6 +178,8 @@ def test_warm_up_does_not_warn_about_its_own_scene(monkeypatch):
     with warnings.catch_warnings():
         warnings.simplefilter("error", run_module.SteadyStateWarning)
         run_module.warm_up(threads=1)
+    # the workflow's runs use the active zone: its freezing kernel is compiled too (no cache race later)
+    assert transfers.freeze_particles.signatures
 
 
 def test_units_and_long_names(tiny_run):
@@ -330,7 +332,21 @@ def zoned(scene: Scene, k: float | None) -> Scene:
     return replace(scene, discretisation=replace(scene.discretisation, active_zone_contact_radii=k))
 
 
-def test_active_zone_follows_the_sphere_and_freezes_what_it_leaves(tiny_scene):
+@pytest.fixture
+def no_zone_floor(monkeypatch):
+    """The tiny scene's zone in contact radii (its 20 h floor would cover the whole 40 h block)."""
+    monkeypatch.setattr(scene_module, "ACTIVE_ZONE_MIN_PARTICLES", 0.0)
+
+
+def test_active_zone_half_width_has_a_floor_in_particle_sizes(tiny_scene):
+    a, h = tiny_scene.expected_contact()[0], tiny_scene.discretisation.particle_size_m
+    assert zoned(tiny_scene, None).active_zone_half_width_m is None
+    assert zoned(tiny_scene, 4.0).active_zone_half_width_m == pytest.approx(20 * h)  # 4 a = 13 h here
+    assert zoned(tiny_scene, 8.0).active_zone_half_width_m == pytest.approx(8 * a)
+    assert solver.init(zoned(tiny_scene, 4.0), n_chunks=1)[1].zone_half_width_m == pytest.approx(20 * h)
+
+
+def test_active_zone_follows_the_sphere_and_freezes_what_it_leaves(tiny_scene, no_zone_floor):
     """The zone holds the particles that started within k a of the sphere's centre; those it has
     left keep their position and stress, those it has not reached are untouched, and the grid
     slabs it has left hold zero velocity."""
@@ -338,16 +354,22 @@ def test_active_zone_follows_the_sphere_and_freezes_what_it_leaves(tiny_scene):
     p, z = state.particles, state.zone
     seeded = p.x.copy()
     half_width = 2.0 * tiny_scene.expected_contact()[0]
-    assert const.zone_half_width == pytest.approx(half_width)
+    assert const.zone_half_width_m == pytest.approx(half_width)
     ranges = []
     frozen = None
+    g = const.grid
+    slab = g.shape[1] * g.shape[2]
     while state.sphere.phase != "done":
+        xc = state.sphere.centre[0]  # where the step's zone update sees the sphere
         solver.step(state, const)
         ranges.append((z.p_lo, z.p_hi, z.n_lo, z.n_hi, z.i_free_lo, z.i_free_hi))
+        # every active particle's stencil (x slabs bx .. bx + 2) lies in the node range the step worked on
+        bx = np.floor((p.x[z.p_lo:z.p_hi, 0] - g.origin[0]) / g.dx - 0.5)
+        assert bx.min() >= z.n_lo // slab and bx.max() + 2 < z.n_hi // slab
         if frozen is None and state.sphere.slid_m > 0.5 * tiny_scene.sliding.distance_m:
             frozen = (z.p_lo, p.x[:z.p_lo].copy(), p.stress[:z.p_lo].copy(), state.step)
     # the zone's ends bracket the sphere's centre -/+ k a in the particles' initial x
-    x0, xc = const.zone_x0, state.sphere.centre[0]
+    x0 = const.zone_x0_m
     assert x0[z.p_lo] >= xc - half_width and x0[z.p_lo - 1] < xc - half_width
     assert x0[z.p_hi - 1] <= xc + half_width and x0[z.p_hi] > xc + half_width
     assert 0 < z.p_lo < z.p_hi < p.n
@@ -368,6 +390,17 @@ def test_active_zone_follows_the_sphere_and_freezes_what_it_leaves(tiny_scene):
     assert np.abs(p.stress[:z.p_lo]).max() > 0.0
 
 
+def test_a_particle_leaving_the_active_zone_stops_the_run_naming_the_zone(tiny_scene, no_zone_floor):
+    state, const = solver.init(zoned(tiny_scene, 2.0), n_chunks=1)
+    while state.sphere.phase != "slide":
+        solver.step(state, const)
+    z = state.zone
+    assert z.p_hi < state.particles.n  # the zone's front clamp is on
+    state.particles.x[z.p_hi - 1, 0] = z.check_hi_m[0] + 0.5 * const.grid.dx  # pushed past the zone's slabs
+    with pytest.raises(solver.SimulationError, match=r"active zone's grid slabs.*active_zone_contact_radii"):
+        solver.step(state, const)
+
+
 def test_an_active_zone_covering_the_block_changes_nothing(tiny_scene, tiny_run):
     wide = simulate(zoned(tiny_scene, 100.0), progress=False, threads=1)
     for q in ("mu", "mu_pl", "dp", "Fz_mean", "penetration"):
@@ -376,7 +409,7 @@ def test_an_active_zone_covering_the_block_changes_nothing(tiny_scene, tiny_run)
     assert float(wide.frozen_kinetic_loss[-1]) == 0.0
 
 
-def test_an_active_zone_reports_its_work_and_keeps_the_energy_balance(tiny_scene, tiny_run):
+def test_an_active_zone_reports_its_work_and_keeps_the_energy_balance(tiny_scene, tiny_run, no_zone_floor):
     """A zone of 4 expected contact radii works on about half the particle-steps of the tiny scene,
     keeps the energy account (the frozen particles' elastic energy stays in it, their kinetic
     energy is counted as lost) and moves mu by a few per cent, far less than halving h does

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from plough.mpm import scene as scene_module
 from plough.mpm import solver
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
@@ -34,8 +35,10 @@ def test_active_fraction_of_simple_runs():
     assert f == pytest.approx(0.1, rel=1e-12)
 
 
-def test_active_fraction_follows_the_solver():
-    """The estimate's share of particle-steps against the solver's count on a coarse reference run."""
+def test_active_fraction_follows_the_solver(monkeypatch):
+    """The estimate's share of particle-steps against the solver's count on a coarse reference run
+    (its zone in contact radii: the 20 h floor would cover most of the block at h = 20 um)."""
+    monkeypatch.setattr(scene_module, "ACTIVE_ZONE_MIN_PARTICLES", 0.0)
     scene = Scene.from_yaml(ROOT / "examples" / "uncoated_rigid_plastic.yaml").with_sized_domain()
     scene = replace(scene, discretisation=replace(scene.discretisation, particle_size_m=20e-6,
                                                   active_zone_contact_radii=4.0))

@@ -202,7 +202,10 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, last_push, step, hold_steps, ori
     writes the per-node contact memory last_push (the step a node's velocity was last cut by the
     normal projection): a node pushed now, or within the last ``hold_steps`` steps, is in contact
     and carries interface shear. Writes grid_v of contact nodes and out[0:N_OUT] (see the OUT_*
-    indices).
+    indices). It works on the nodes around the sphere whatever the active zone: nodes outside the
+    zone's range have no mass and are skipped; a clamped node the sphere touched would take the
+    sphere's velocity, which the zone's width (at least 2 expected contact radii from the centre)
+    keeps from happening.
     """
     ny, nz = shape[1], shape[2]
     for k in range(N_OUT):

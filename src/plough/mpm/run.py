@@ -16,6 +16,7 @@ import numpy as np
 import xarray as xr
 
 from plough.mpm import contact, io, solver, transfers
+from plough.mpm.constitutive import pack_materials
 from plough.mpm.scene import PRESETS, Scene
 
 
@@ -54,10 +55,10 @@ class _Recorder:
             "particle_penetration": pen, "contact_area_xy": k * float(w.contact_out[contact.OUT_AREA_XY]),
             "material_top": float(s.particles.x[:, 2].max()),
             "external_work": k * w.external_work, "plastic_work": k * w.plastic_work,
-            "elastic_energy": k * (float(acc[:, transfers.ACC_ELASTIC].sum()) + s.zone.frozen_elastic),
+            "elastic_energy": k * (float(acc[:, transfers.ACC_ELASTIC].sum()) + s.zone.frozen_elastic_J),
             "kinetic_energy": k * float(acc[:, transfers.ACC_KINETIC].sum()),
             "interface_dissipation": k * w.interface_dissipation, "contact_impact_loss": k * w.contact_impact_loss,
-            "frozen_kinetic_loss": k * s.zone.frozen_kinetic_loss,
+            "frozen_kinetic_loss": k * s.zone.frozen_kinetic_loss_J,
             "heat": k * w.heat, "time": s.time,
         })
         self.slid.append(s.sphere.slid_m if s.sphere.phase in ("slide", "done") else 0.0)
@@ -220,7 +221,8 @@ def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir:
 
 
 def warm_up(threads: int | None = None) -> float:
-    """Compile (or load from numba's cache) every kernel by running a tiny scene; returns seconds.
+    """Compile (or load from numba's cache) every kernel by running a tiny scene (and calling the
+    active zone's freezing kernel); returns seconds.
 
     Workflows call this once before fanning runs out: parallel first-time compilation of
     ``cache=True`` functions can race on the cache files.
@@ -238,4 +240,12 @@ def warm_up(threads: int | None = None) -> float:
     with warnings.catch_warnings():  # the compile-only scene is too short to be steady: not the user's run
         warnings.simplefilter("ignore", SteadyStateWarning)
         simulate(scene, progress=False, threads=threads)
+    _compile_freeze(pack_materials(scene.layers.materials))
     return time.perf_counter() - t0
+
+
+def _compile_freeze(table: np.ndarray) -> None:
+    """Compile the active zone's freezing kernel, which the warm-up scene (no zone) never calls."""
+    one = np.zeros((1, 3))
+    transfers.freeze_particles(0, 1, one.copy(), np.zeros((1, 3, 3)), one.copy(), np.zeros((1, 6)), np.ones(1),
+                               np.ones(1), np.ones(1), np.zeros(1, np.int32), np.zeros(1, np.int32), np.ones(1), table)

@@ -52,8 +52,11 @@ STIFFNESS_FACTOR = 1.0
 SETTLE_STEPS = 300
 INTEGRAL_STEPS = 100.0
 #: grid slabs worked on beyond each clamp face of the active zone, so that the stencils of the
-#: active particles (displaced by a few um at most) stay on nodes the step updates
-ZONE_PAD_CELLS = 3
+#: active particles stay on nodes the step updates: a particle at its starting position keeps two
+#: slabs to spare, one of which the positions check (``ActiveZone.check_lo_m``) may use up: a
+#: particle moved about a cell past its start at the zone's end (material the sphere pushes far
+#: ahead) stops the run
+ZONE_PAD_CELLS = 4
 
 
 class SimulationError(RuntimeError):
@@ -101,9 +104,9 @@ class Constants:
     steps_slide: int
     shape: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.int64))
     mirror_j0: int = -1  # index of the node plane y = 0 with symmetry, -1 without
-    zone_half_width: float = 0.0  # m, active zone behind and ahead of the sphere centre; 0: every particle
-    zone_x0: np.ndarray = field(default_factory=lambda: np.zeros(0))  # initial x of the particles, ascending
-    block_length: float = 0.0  # m
+    zone_half_width_m: float = 0.0  # m, active zone behind and ahead of the sphere centre; 0: every particle
+    zone_x0_m: np.ndarray = field(default_factory=lambda: np.zeros(0))  # initial x of the particles, ascending
+    block_length_m: float = 0.0  # m
 
 
 @dataclass
@@ -112,7 +115,9 @@ class ActiveZone:
 
     Nodes of x index below ``i_free_lo`` or above ``i_free_hi`` lie in frozen material and hold
     zero velocity. Both ranges only move forward: a particle the zone has left stays frozen,
-    with the elastic energy it keeps and the kinetic energy it lost counted here.
+    with the elastic energy it keeps and the kinetic energy it lost counted here. ``check_lo_m``
+    and ``check_hi_m`` bound the particles' positions (the grid's interior, narrowed in x so that
+    every active particle's stencil stays in [n_lo, n_hi) on the next step).
     """
 
     p_lo: int
@@ -121,8 +126,10 @@ class ActiveZone:
     n_hi: int
     i_free_lo: int
     i_free_hi: int
-    frozen_elastic: float = 0.0  # J
-    frozen_kinetic_loss: float = 0.0  # J
+    check_lo_m: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
+    check_hi_m: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    frozen_elastic_J: float = 0.0
+    frozen_kinetic_loss_J: float = 0.0
 
 
 @dataclass
@@ -219,17 +226,18 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
         L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
     )
-    if disc.active_zone_contact_radii is not None:
-        const.zone_half_width = disc.active_zone_contact_radii * a_exp
-        const.zone_x0 = particles.x[:, 0].copy()
-        const.block_length = scene.domain.length_m
-        if np.any(np.diff(const.zone_x0) < 0.0):
+    if scene.active_zone_half_width_m is not None:
+        const.zone_half_width_m = scene.active_zone_half_width_m
+        const.zone_x0_m = particles.x[:, 0].copy()
+        const.block_length_m = scene.domain.length_m
+        if np.any(np.diff(const.zone_x0_m) < 0.0):
             raise AssertionError("particles are not seeded x-major: the active zone needs them sorted along x")
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
-    if const.zone_half_width > 0.0:  # empty ranges, opened by the first update
+    if const.zone_half_width_m > 0.0:  # empty ranges, opened by the first update
         zone = ActiveZone(p_lo=0, p_hi=0, n_lo=0, n_hi=0, i_free_lo=-1, i_free_hi=-1)
     else:
         zone = ActiveZone(p_lo=0, p_hi=particles.n, n_lo=0, n_hi=grid.n_nodes, i_free_lo=0, i_free_hi=grid.shape[0])
+    zone.check_lo_m, zone.check_hi_m = const.grid_lo.copy(), const.grid_hi.copy()
     state = State(particles=particles, sphere=sphere, work=work, zone=zone)
     update_active_zone(state, const)
     return state, const
@@ -272,8 +280,8 @@ def step(s: State, c: Constants) -> None:
         transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0, z.n_lo, z.n_hi)
     transfers.g2p_update(g.origin, g.dx, c.dt, c.shape, p.x, p.v, w.v_grid, p.C, p.stress, p.J, p.vol0, p.mass,
                          p.eps_p, p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney,
-                         sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc, c.grid_lo, c.grid_hi, w.grid_div,
-                         c.project_dilatation, w.L_buf, z.p_lo, z.p_hi)
+                         sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc, z.check_lo_m, z.check_hi_m,
+                         w.grid_div, c.project_dilatation, w.L_buf, z.p_lo, z.p_hi)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
@@ -284,27 +292,27 @@ def step(s: State, c: Constants) -> None:
 def update_active_zone(s: State, c: Constants) -> None:
     """Move the active zone with the sphere: freeze the particles it leaves, retire the grid slabs.
 
-    The zone holds the particles whose initial x lies within ``zone_half_width`` of the sphere's
-    centre; the clamp faces sit at the zone's ends, except where the zone reaches past the
-    block's ends (the block's own free end faces stay free). Retired nodes get zero mass and
-    velocity, so a particle that strays onto them is held as by the clamp.
+    The zone holds the particles whose initial x lies within ``zone_half_width_m`` of the sphere's
+    centre; a clamp face sits at each end of the zone where particles lie frozen beyond it (until
+    then the block's own free end faces stay free). Retired nodes get zero mass and velocity.
     """
-    if c.zone_half_width <= 0.0:
+    if c.zone_half_width_m <= 0.0:
         return
     z, w, p = s.zone, s.work, s.particles
     g = c.grid
     nx, ny, nz = g.shape
-    lo_x = s.sphere.centre[0] - c.zone_half_width
-    hi_x = s.sphere.centre[0] + c.zone_half_width
-    p_lo = max(z.p_lo, int(np.searchsorted(c.zone_x0, lo_x, side="left")))
-    p_hi = max(z.p_hi, int(np.searchsorted(c.zone_x0, hi_x, side="right")))
+    lo_x = s.sphere.centre[0] - c.zone_half_width_m
+    hi_x = s.sphere.centre[0] + c.zone_half_width_m
+    p_lo = max(z.p_lo, int(np.searchsorted(c.zone_x0_m, lo_x, side="left")))
+    p_hi = max(z.p_hi, int(np.searchsorted(c.zone_x0_m, hi_x, side="right")))
     if p_lo > z.p_lo:
         elastic, kinetic = transfers.freeze_particles(z.p_lo, p_lo, p.v, p.C, w.v_grid, p.stress, p.J, p.vol0, p.mass,
                                                       p.mat_a, p.mat_b, p.frac_a, c.table)
-        z.frozen_elastic += elastic
-        z.frozen_kinetic_loss += kinetic
-    i_free_lo = math.ceil((lo_x - g.origin[0]) / g.dx) if lo_x > 0.0 else 0
-    i_free_hi = math.floor((hi_x - g.origin[0]) / g.dx) if hi_x < c.block_length else nx
+        z.frozen_elastic_J += elastic
+        z.frozen_kinetic_loss_J += kinetic
+    n = c.zone_x0_m.size
+    i_free_lo = math.ceil((lo_x - g.origin[0]) / g.dx) if p_lo > 0 else 0
+    i_free_hi = math.floor((hi_x - g.origin[0]) / g.dx) if p_hi < n else nx
     slab = ny * nz
     n_lo = max(z.n_lo, max(i_free_lo - ZONE_PAD_CELLS, 0) * slab)
     n_hi = max(z.n_hi, min(i_free_hi + ZONE_PAD_CELLS + 1, nx) * slab)
@@ -314,6 +322,10 @@ def update_active_zone(s: State, c: Constants) -> None:
         w.grid_div[z.n_lo:n_lo] = 0.0
     z.p_lo, z.p_hi, z.n_lo, z.n_hi = p_lo, p_hi, n_lo, n_hi
     z.i_free_lo, z.i_free_hi = max(z.i_free_lo, i_free_lo), max(z.i_free_hi, i_free_hi)
+    # a stencil spans x - 1.5 dx .. x + 1.5 dx; one cell more for the range's advance before the next check
+    z.check_lo_m[0] = c.grid_lo[0] if n_lo == 0 else max(c.grid_lo[0], g.origin[0] + (n_lo // slab + 1.5) * g.dx)
+    z.check_hi_m[0] = c.grid_hi[0] if n_hi == nx * slab else min(c.grid_hi[0],
+                                                                 g.origin[0] + (n_hi // slab - 2.5) * g.dx)
 
 
 def reaction_z(w: Work) -> float:
@@ -404,6 +416,12 @@ def check_stability(s: State, c: Constants) -> None:
             cause = (f"a particle rose above the grid's top (z = {c.grid_hi[2] * 1e6:.1f} um over the original "
                      "surface): material the sphere pushes up (a growing prow: set domain.headroom_m higher) or a "
                      "particle flung off the surface (lower mass_scaling or speed)")
+        elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
+            zone = s.zone
+            cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo_m[0] * 1e6:.1f}.."
+                     f"{zone.check_hi_m[0] * 1e6:.1f} um), about a cell past its start at the zone's end: material "
+                     "the sphere pushes beyond the zone (widen discretisation.active_zone_contact_radii, or switch "
+                     "it off)")
         raise SimulationError(f"unstable run {where}: {cause}{_particle_report(s, c, index)}")
     kinetic = float(acc[:, transfers.ACC_KINETIC].sum())
     budget = 2.0 * abs(s.work.external_work) + c.load_N * c.grid.dx
@@ -411,6 +429,12 @@ def check_stability(s: State, c: Constants) -> None:
         raise SimulationError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
                               f"by the sphere ({s.work.external_work:.3g} J): inertia dominates; lower "
                               "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")
+
+
+def _left_zone(s: State, c: Constants, x: float) -> bool:
+    """Whether x lies on the grid but outside the active zone's slabs (``ActiveZone.check_lo_m``/``hi``)."""
+    z = s.zone
+    return c.grid_lo[0] <= x <= c.grid_hi[0] and not (z.check_lo_m[0] <= x <= z.check_hi_m[0])
 
 
 def _particle_report(s: State, c: Constants, index: int) -> str:

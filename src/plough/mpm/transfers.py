@@ -255,7 +255,9 @@ def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_
     If ``scatter_dilatation`` is 1 also writes grid_buf[c, node, 0] = sum w m and
     grid_buf[c, node, 1] = sum w m tr L over chunk c's particles (zeroing those two channels of
     the active nodes n_lo <= node < n_hi first; the P2G content is no longer needed), for
-    ``grid_dilatation``. Race-free: particle p writes only its own entries, chunk c only grid_buf[c].
+    ``grid_dilatation``. The active particles' stencils must lie in the node range (the solver's
+    positions check keeps them there). Race-free: particle p writes only its own entries, chunk c
+    only grid_buf[c].
     """
     n = p_hi - p_lo
     n_chunks = grid_buf.shape[0]
@@ -473,8 +475,8 @@ def _det_i_plus(dt, L):
 def freeze_particles(p_from, p_to, v, C, v_grid, stress, J, vol0, mass, mat_a, mat_b, frac_a, table):
     """Freeze the particles p_from <= p < p_to as the active zone leaves them behind.
 
-    Reads their stress, J, vol0, mass and materials; zeroes their v, C and v_grid (a frozen
-    particle is at rest and keeps its position and stress). Returns (elastic energy they keep,
+    Reads their v, stress, J, vol0, mass, materials and the packed table; zeroes their v, C and
+    v_grid (a frozen particle is at rest and keeps its position and stress). Returns (elastic energy they keep,
     kinetic energy they lose), in J. Serial: a few particles per step.
     """
     elastic = 0.0

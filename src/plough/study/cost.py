@@ -66,10 +66,9 @@ def estimate(scene: Scene) -> RunCost:
     press = dp / (scene.sliding.press_speed_fraction * v) / dt
     slide = scene.sliding.distance_m / v / dt
     fraction = 1.0
-    k = scene.discretisation.active_zone_contact_radii
-    if k is not None:
-        a, _ = scene.expected_contact()
-        fraction = active_fraction(scene.start_x_m, scene.sliding.distance_m, dom.length_m, k * a,
+    half_width = scene.active_zone_half_width_m
+    if half_width is not None:
+        fraction = active_fraction(scene.start_x_m, scene.sliding.distance_m, dom.length_m, half_width,
                                    press + SETTLE_STEPS, slide)
     return RunCost(particles=particles, steps=int(press + SETTLE_STEPS + slide), active_fraction=fraction)
 

@@ -254,7 +254,8 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
                                       dilatation=str(numerics.get("dilatation", "projected")),
                                       graded=numerics.get("graded", False),
                                       fine_zone_contact_radii=float(numerics.get("fine_zone_contact_radii", 1.5)),
-                                      active_zone_contact_radii=_optional_float(numerics.get("active_zone_contact_radii"))),
+                                      active_zone_contact_radii=_optional_float(
+                                          numerics.get("active_zone_contact_radii"))),
         outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
                         records=int(numerics["records"]),
                         buried_profile_depth_m=float(numerics["buried_profile_depth_um"]) * 1e-6),
