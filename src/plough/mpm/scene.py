@@ -256,9 +256,9 @@ class Discretisation:
     slide) are updated;
     the rest are frozen (they keep their position and stress, and the grid nodes in their region
     hold zero velocity, so the active material is clamped there as at the block's curved surface).
-    The zone moves with the sphere and a particle that leaves it behind stays frozen. The sized
-    block's end margins are the same clamp at the start and the end of the slide; this keeps it
-    throughout. None (default) updates every particle (README, "Active zone").
+    The zone moves with the sphere and a particle that leaves it behind stays frozen; until
+    particles lie frozen beyond an end of the zone, the block's own end face there stays free.
+    None (default) updates every particle (README, "Active zone").
     """
 
     particle_size_m: float = 10e-6

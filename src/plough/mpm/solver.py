@@ -106,7 +106,6 @@ class Constants:
     mirror_j0: int = -1  # index of the node plane y = 0 with symmetry, -1 without
     zone_half_width_m: float = 0.0  # m, active zone behind and ahead of the sphere centre; 0: every particle
     zone_x0_m: np.ndarray = field(default_factory=lambda: np.zeros(0))  # initial x of the particles, ascending
-    block_length_m: float = 0.0  # m
 
 
 @dataclass
@@ -229,7 +228,6 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     if scene.active_zone_half_width_m is not None:
         const.zone_half_width_m = scene.active_zone_half_width_m
         const.zone_x0_m = particles.x[:, 0].copy()
-        const.block_length_m = scene.domain.length_m
         if np.any(np.diff(const.zone_x0_m) < 0.0):
             raise AssertionError("particles are not seeded x-major: the active zone needs them sorted along x")
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
