@@ -203,9 +203,11 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, last_push, step, hold_steps, ori
     normal projection): a node pushed now, or within the last ``hold_steps`` steps, is in contact
     and carries interface shear. Writes grid_v of contact nodes and out[0:N_OUT] (see the OUT_*
     indices). It works on the nodes around the sphere whatever the active zone: nodes outside the
-    zone's range have no mass and are skipped; a clamped node the sphere touched would take the
-    sphere's velocity, which the zone's width (at least 2 expected contact radii from the centre)
-    keeps from happening.
+    zone's range have no mass and are skipped. A clamped node the sphere pushed would take the
+    sphere's velocity; this is not excluded here: behind the sphere it moves away from the material
+    (no push), and ahead the zone's end lies at least 2 expected contact radii and 20 h from the
+    centre (over the workflow's runs the sphere's surface there is at least 5.6 um above the
+    expected groove depth, about one contact reach at h = 2.5 um; README, "Active zone").
     """
     ny, nz = shape[1], shape[2]
     for k in range(N_OUT):
