@@ -1,8 +1,10 @@
 """Where the time of an MPM step goes, kernel by kernel, and the memory-bandwidth bound.
 
-    python benchmarks/kernel_profile.py [--h-um 5] [--threads 2] [--steps 400] [--paper-block] [--out FILE]
+    python benchmarks/kernel_profile.py [--h-um 5] [--threads 2] [--steps 400] [--paper-block] [--scene FILE]
+        [--out FILE]
 
-Runs the reference scene (examples/uncoated_rigid_plastic.yaml, sized block or --paper-block) through the press
+Runs the reference scene (examples/uncoated_rigid_plastic.yaml, or ``--scene``; sized block or --paper-block)
+through the press
 and into the slide, then times ``--steps`` steps with every kernel the step calls wrapped in a
 timer (the wrappers replace the module attributes ``solver.step`` looks up, so the step itself is
 the one that runs in production). Reports the median per-step time of each kernel over blocks of
@@ -53,6 +55,8 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--steps", type=int, default=400)
     parser.add_argument("--paper-block", action="store_true", help="the paper's 0.2 x 1 mm block, not the sized one")
+    parser.add_argument("--scene", type=Path, default=ROOT / "examples" / "uncoated_rigid_plastic.yaml",
+                        help="scene file (default the uncoated rigid-plastic reference scene)")
     parser.add_argument("--bandwidth-GB-s", type=float, default=43.0,
                         help="STREAM triad bandwidth of the machine (../shared/peer-bench/bandwidth.py)")
     parser.add_argument("--out", type=Path, default=None,
@@ -61,7 +65,7 @@ def main() -> None:
     numba.set_num_threads(args.threads)
     from dataclasses import replace
 
-    scene = Scene.from_yaml(ROOT / "examples" / "uncoated_rigid_plastic.yaml")
+    scene = Scene.from_yaml(args.scene)
     scene = replace(scene, discretisation=replace(scene.discretisation, particle_size_m=args.h_um * 1e-6))
     if not args.paper_block:
         scene = scene.with_sized_domain()
@@ -111,7 +115,8 @@ def main() -> None:
     bpp = bytes_per_particle_step(n, const.grid.n_nodes, state.work.grid_buf.shape[0])
     bound = args.bandwidth_GB_s * 1e9 / bpp["total_bytes"]
     result = {
-        "h_um": args.h_um, "threads": args.threads, "particles": n, "grid_nodes": const.grid.n_nodes,
+        "scene": scene.name, "h_um": args.h_um, "threads": args.threads, "particles": n,
+        "grid_nodes": const.grid.n_nodes,
         "steps_timed": args.steps, "median_seconds_per_step": med,
         "share": {k: med[k] / med["step"] for k in med if k != "step"},
         "particle_steps_per_s": n / med["step"], **bpp, "bandwidth_GB_s": args.bandwidth_GB_s,
@@ -119,7 +124,9 @@ def main() -> None:
     }
     block_name = "_paper_block" if args.paper_block else ""
     result["block"] = "paper" if args.paper_block else "sized"
-    out = args.out or ROOT / "benchmarks" / "results" / f"kernel_profile_h{args.h_um:g}{block_name}.json"
+    default_scene = args.scene.resolve() == (ROOT / "examples" / "uncoated_rigid_plastic.yaml").resolve()
+    scene_name = "" if default_scene else f"_{scene.name}"
+    out = args.out or ROOT / "benchmarks" / "results" / f"kernel_profile{scene_name}_h{args.h_um:g}{block_name}.json"
     out.write_text(json.dumps(result, indent=2) + "\n")
     print(f"{n:,} particles, {const.grid.n_nodes:,} nodes, {args.threads} threads: "
           f"{n / med['step'] / 1e6:.2f} M particle-steps/s (median of {args.steps // block} blocks of {block})")

@@ -56,6 +56,7 @@ def main() -> None:
     nodes = int(np.prod(shape))
     grid_v, grid_div, buf = rng.normal(0, 0.01, (nodes, 6)), np.zeros(nodes), tr.allocate_grid_buffers(chunks, nodes)
     eps_p, temperature = np.zeros(n), np.full(n, 298.0)
+    sigma_y0 = np.full(n, 300e6)  # the rigid-plastic table's flow stress at rest
     mat, frac, near = np.zeros(n, dtype=np.int32), np.ones(n), np.zeros(n, dtype=np.int8)
     acc, v_grid, L_buf = np.zeros((chunks, tr.N_ACC)), np.zeros((n, 3)), tr.allocate_velocity_gradient_scratch(chunks)
     lo, hi, far = origin + dx, origin + dx * (shape - 2), np.ones(3)
@@ -64,8 +65,9 @@ def main() -> None:
         tr.g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, 1.0, buf, project, 0, n, 0, buf.shape[1])
 
     def update(project: int) -> None:
-        tr.g2p_update(origin, dx, 1e-9, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, mat, mat,
-                      frac, table, 1.0, 0.9, far, 1e-6, 3 * dx, near, acc, lo, hi, grid_div, project, L_buf, 0, n)
+        tr.g2p_update(origin, dx, 1e-9, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature,
+                      sigma_y0, mat, mat, frac, table, 1.0, 0.9, far, 1e-6, 3 * dx, near, acc, lo, hi, grid_div,
+                      project, L_buf, 0, n)
 
     def step(project: int) -> None:
         kinematics(project)

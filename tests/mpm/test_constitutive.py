@@ -55,6 +55,11 @@ def expected_flow(mat: Material, eps: float, rate: float, T: float) -> float:
     raise TypeError(f)
 
 
+def rest(prm_a: np.ndarray, prm_b: np.ndarray, frac_a: float, eps_p: np.ndarray, temp: np.ndarray) -> np.ndarray:
+    """The flow stress at rest of a one-particle state, the cache ``update_stress`` reads and keeps."""
+    return np.array([c.mixed_flow_stress(prm_a, prm_b, frac_a, eps_p[0], 0.0, temp[0])])
+
+
 def von_mises(row: np.ndarray) -> float:
     s = np.array(row[:3]) - row[:3].mean()
     return math.sqrt(1.5 * (s @ s + 2.0 * (row[3] ** 2 + row[4] ** 2 + row[5] ** 2)))
@@ -78,6 +83,7 @@ def drive(mat: Material, L: np.ndarray, dt: float, nsteps: int, rate_scale: floa
     stress = np.zeros((1, 6))
     eps_p = np.zeros(1)
     temp = np.full(1, T_ROOM)
+    sy0 = rest(prm, prm, 1.0, eps_p, temp)  # carried through the steps: update_stress keeps it current
     F = np.eye(3)
     step = np.eye(3) + dt * L
     hist = {k: [] for k in ("vm", "eps_p", "deps", "w", "T_before", "T_after", "J")}
@@ -85,7 +91,8 @@ def drive(mat: Material, L: np.ndarray, dt: float, nsteps: int, rate_scale: floa
         F = step @ F
         J = float(np.linalg.det(F))
         T_before = float(temp[0])
-        deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, prm, prm, 1.0, rate_scale, tq)
+        deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, prm, prm, 1.0, rate_scale, tq)
+        assert sy0[0] == c.flow_stress(prm, float(eps_p[0]), 0.0, float(temp[0]))  # the cache stays exact
         hist["vm"].append(von_mises(stress[0]))
         hist["eps_p"].append(float(eps_p[0]))
         hist["deps"].append(deps)
@@ -297,7 +304,8 @@ def test_elastic_below_yield() -> None:
     eps_p = np.zeros(1)
     temp = np.full(1, T_ROOM)
     J = 1.0 + np.trace(eps)
-    deps, w = c.update_stress(stress, 0, eps / dt, dt, J, eps_p, temp, prm, prm, 1.0, 0.01, 0.9)
+    deps, w = c.update_stress(stress, 0, eps / dt, dt, J, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), prm, prm,
+                              1.0, 0.01, 0.9)
     dev = eps - np.trace(eps) / 3 * np.eye(3)
     expect = voigt(2 * G * dev + K * np.trace(eps) * np.eye(3))
     # round-off: J - 1 ~ 1e-5 carries an absolute error ~1e-16, i.e. ~1e-11 relative
@@ -338,8 +346,9 @@ def test_rigid_rotation_preserves_invariants() -> None:
     dt, n = 2e-6, 300  # 0.075 rad per step, 22 rad in all
     eps_p = np.zeros(1)
     temp = np.full(1, T_ROOM)
+    sy0 = rest(prm, prm, 1.0, eps_p, temp)
     for _ in range(n):
-        c.update_stress(stress, 0, W, dt, J, eps_p, temp, prm, prm, 1.0, 0.01, 0.9)
+        c.update_stress(stress, 0, W, dt, J, eps_p, temp, sy0, prm, prm, 1.0, 0.01, 0.9)
     assert von_mises(stress[0]) == pytest.approx(75e6, rel=1e-12)
     assert pressure(stress[0]) == pytest.approx(p0, rel=1e-12)
     assert eps_p[0] == 0.0 and temp[0] == T_ROOM
@@ -359,7 +368,8 @@ def test_rotation_direction_matches_spin() -> None:
     W = np.array([[0, -w[2], w[1]], [w[2], 0, -w[0]], [-w[1], w[0], 0]])
     dt = 1e-5
     stress = voigt(s0)[None, :].copy()
-    c.update_stress(stress, 0, W, dt, 1.0, np.zeros(1), np.full(1, T_ROOM), prm, prm, 1.0, 1.0, 0.9)
+    eps_p, temp = np.zeros(1), np.full(1, T_ROOM)
+    c.update_stress(stress, 0, W, dt, 1.0, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), prm, prm, 1.0, 1.0, 0.9)
     Q = _rodrigues(w, dt)
     exact = Q @ s0 @ Q.T
     first = dt * (W @ s0 - s0 @ W)
@@ -440,7 +450,8 @@ def test_adiabatic_heating(frac_a: float) -> None:
     eps_p = np.full(1, eps0)
     temp = np.full(1, T0)
     deps, w = c.update_stress(
-        stress, 0, np.zeros((3, 3)), dt, 1.0, eps_p, temp, pa, pb, frac_a, rate_scale, tq
+        stress, 0, np.zeros((3, 3)), dt, 1.0, eps_p, temp, rest(pa, pb, frac_a, eps_p, temp), pa, pb, frac_a,
+        rate_scale, tq
     )
     rate = deps / dt * rate_scale
     sy = frac_a * expected_flow(a, eps0 + deps, rate, T0) + (1 - frac_a) * expected_flow(
@@ -469,7 +480,9 @@ def test_parallel_driver_matches_single_updates() -> None:
     eps_p = rng.uniform(0, 1, n)
     temp = rng.uniform(280, 450, n)
     dt, rs, tq = 1e-6, 0.01, 0.9
-    ref = (stress.copy(), eps_p.copy(), temp.copy())
+    sy0 = np.zeros(n)
+    c.rest_flow_stresses(eps_p, temp, mat_a, mat_b, frac_a, table, sy0)
+    ref = (stress.copy(), eps_p.copy(), temp.copy(), sy0.copy())
     ref_d, ref_w = np.zeros(n), np.zeros(n)
     for i in range(n):
         ref_d[i], ref_w[i] = c.update_stress(
@@ -480,6 +493,7 @@ def test_parallel_driver_matches_single_updates() -> None:
             J[i],
             ref[1],
             ref[2],
+            ref[3],
             table[mat_a[i]],
             table[mat_b[i]],
             frac_a[i],
@@ -487,8 +501,8 @@ def test_parallel_driver_matches_single_updates() -> None:
             tq,
         )
     d, w = np.zeros(n), np.zeros(n)
-    c.update_stresses(stress, L_all, dt, J, eps_p, temp, mat_a, mat_b, frac_a, table, rs, tq, d, w)
-    for got, want in zip((stress, eps_p, temp, d, w), (*ref, ref_d, ref_w), strict=True):
+    c.update_stresses(stress, L_all, dt, J, eps_p, temp, sy0, mat_a, mat_b, frac_a, table, rs, tq, d, w)
+    for got, want in zip((stress, eps_p, temp, sy0, d, w), (*ref, ref_d, ref_w), strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-14, atol=0)
     assert (d > 0).sum() > n // 4  # the random states exercise the plastic branch
 
@@ -528,7 +542,8 @@ def test_property_never_outside_yield_surface(
     dt, rs = 10.0**log_dt, 10.0**log_rs
     eps_p = np.full(1, eps0)
     temp = np.full(1, T0)
-    deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, TABLE[ia], TABLE[ib], frac, rs, 0.9)
+    sy0 = rest(TABLE[ia], TABLE[ib], frac, eps_p, temp)
+    deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, TABLE[ia], TABLE[ib], frac, rs, 0.9)
     assert np.all(np.isfinite(stress)) and math.isfinite(deps) and math.isfinite(w)
     assert math.isfinite(temp[0]) and temp[0] >= T0
     assert deps >= 0.0 and w >= 0.0 and eps_p[0] == pytest.approx(eps0 + deps, rel=1e-15)

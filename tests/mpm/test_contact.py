@@ -22,7 +22,7 @@ import pytest
 
 from plough.materials import rigid_plastic
 from plough.mpm import contact as ct
-from plough.mpm.constitutive import pack_materials
+from plough.mpm.constitutive import pack_materials, rest_flow_stresses
 from plough.mpm.grid import Grid
 from plough.mpm.shape import bspline2, bspline2_grad
 
@@ -304,8 +304,10 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     frac_a = np.where(rng.random(n) < 0.3, 0.4, 1.0)
     near = (rng.random(n) < 0.7).astype(np.int8)
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    ct.scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near,
-                              ORIGIN, DX, SHAPE, centre, radius, -1, cbuf, 0, n)
+    sigma_y0 = np.zeros(n)
+    rest_flow_stresses(eps_p, temperature, mat_a, mat_b, frac_a, table, sigma_y0)
+    ct.scatter_contact_stress(x, stress, mass, vol0, J, sigma_y0, near, ORIGIN, DX, SHAPE, centre, radius, -1, cbuf, 0,
+                              n)
     # independent accumulation
     sy = np.array([450e6 / 3, 900e6 / 3])
     kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
@@ -450,12 +452,9 @@ def _lattice(lo, hi, h):
 def _scatter_block(x, h, centre, radius, mirror_j0=-1):
     """The contact buffer of lattice particles x (cubes of edge h grid units, unstressed, all near)."""
     n = x.shape[0]
-    table = pack_materials([rigid_plastic("sub", 900e6, coating=False)])
-    zeros = np.zeros(n)
     ones = np.ones(n)
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, zeros, np.full(n, 298.0),
-                              np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones, table,
+    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, np.full(n, 300e6),
                               np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, mirror_j0, cbuf, 0, n)
     return cbuf
 

@@ -493,3 +493,26 @@ def test_cli_unstable_run_exits_2_without_traceback(tmp_path, capsys, allow_iner
     lines = [ln for ln in capsys.readouterr().err.splitlines() if not ln.startswith("plough: note: ")]
     assert len(lines) == 1 and lines[0].startswith("plough mpm: error: ")  # one line, no traceback
     assert "unstable run at step" in lines[0] or "lost contact" in lines[0]
+
+
+def test_the_cached_flow_stress_at_rest_follows_every_particle_through_a_run():
+    """``sigma_y0`` (the flow stress at zero rate the elastic check and the contact read) equals the
+    flow law at the particle's plastic strain and temperature after a run with hardening, heating
+    and a mixed coating layer: the cache never goes stale."""
+    from plough.mpm.constitutive import mixed_flow_stress
+
+    scene = Scene.from_dict(scene_dict(load_N=0.5, layers={"coating_thickness_um": 15, "coating": "zinc_coating",
+                                                           "substrate": "dx56"},
+                                       interface={"model": "boundary_layer", "Cp": 0.32, "np": 0.95}))
+    state, const = solver.init(scene, n_chunks=1)
+    p = state.particles
+    for _ in range(1500):
+        solver.step(state, const)
+    assert state.sphere.phase == "slide"
+    flowed = p.eps_p > 0.0
+    assert flowed.sum() > 50 and p.temperature.max() > scene.outputs.initial_temperature_K
+    assert np.any((p.frac_a > 0.0) & (p.frac_a < 1.0) & flowed)  # straddling particles flowed too
+    table = const.table
+    expected = np.array([mixed_flow_stress(table[p.mat_a[i]], table[p.mat_b[i]], p.frac_a[i], p.eps_p[i], 0.0,
+                                           p.temperature[i]) for i in range(p.n)])
+    np.testing.assert_array_equal(p.sigma_y0, expected)

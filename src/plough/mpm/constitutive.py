@@ -60,7 +60,9 @@ __all__ = [
     "mixed_moduli",
     "pack_material",
     "pack_materials",
+    "rest_flow_stresses",
     "return_map",
+    "return_map_at_rest",
     "update_stress",
     "update_stresses",
 ]
@@ -325,6 +327,20 @@ def mixed_moduli(prm_a, prm_b, frac_a):
 def return_map(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T):
     """Radial return of J2 plasticity: the plastic strain increment of one particle.
 
+    :func:`return_map_at_rest` with the flow stress at rest sigma_y(eps_p, 0, T) evaluated here.
+    """
+    return return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T,
+                              mixed_flow_stress(prm_a, prm_b, frac_a, eps_p, 0.0, T))
+
+
+@njit(cache=True)
+def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T, sig0):
+    """Radial return of J2 plasticity, given the flow stress at rest ``sig0`` = sigma_y(eps_p, 0, T).
+
+    The solver keeps ``sig0`` per particle (``sigma_y0``, :func:`rest_flow_stresses`): it changes
+    only when the particle flows, so an elastic step (most particles on most steps) costs no
+    flow-stress evaluation; the result is the same to the bit as evaluating it here.
+
     Reads the packed rows, ``frac_a``, the trial von Mises stress ``q_trial`` (Pa), shear modulus
     ``G``, plastic strain ``eps_p``, time step ``dt`` (simulated s), ``rate_scale`` (= v_experiment
     / v_simulation, turns simulated into physical rates) and ``T`` (K); writes nothing.
@@ -338,7 +354,6 @@ def return_map(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T):
     |f| <= RETURN_RTOL * q_trial (or the bracket has collapsed to round-off).
     Returns ``(d, sigma_y(eps_p + d, d / dt * rate_scale, T))``.
     """
-    sig0 = mixed_flow_stress(prm_a, prm_b, frac_a, eps_p, 0.0, T)
     if q_trial <= sig0:
         return 0.0, sig0
     three_g = 3.0 * G
@@ -391,16 +406,18 @@ def return_map(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T):
 # ----------------------------------------------------------------------------- stress update
 @njit(cache=True)
 def update_stress(
-    stress, p, L, dt, J, eps_p, temperature, prm_a, prm_b, frac_a, rate_scale, taylor_quinney
+    stress, p, L, dt, J, eps_p, temperature, sigma_y0, prm_a, prm_b, frac_a, rate_scale, taylor_quinney
 ):
     """Advance the Cauchy stress of particle ``p`` by one step (eqs. 6.1 and 6.2).
 
     Reads: ``stress[p]`` ((n, 6) Voigt xx, yy, zz, yz, xz, xy; only its deviator is used), ``L``
     ((3, 3) velocity gradient of the particle, L[i, j] = dv_i/dx_j), ``dt``, ``J`` (det F after
-    this step), ``eps_p[p]``, ``temperature[p]``, the packed rows ``prm_a``/``prm_b`` with volume
-    fraction ``frac_a`` of a, ``rate_scale`` (v_experiment / v_simulation) and the Taylor-Quinney
-    factor. Writes: ``stress[p]`` (new Cauchy stress), ``eps_p[p] += deps_p``,
-    ``temperature[p] += taylor_quinney * w / (rho cp)``.
+    this step), ``eps_p[p]``, ``temperature[p]``, ``sigma_y0[p]`` (the flow stress at rest
+    sigma_y(eps_p[p], 0, temperature[p]), kept by :func:`rest_flow_stresses`), the packed rows
+    ``prm_a``/``prm_b`` with volume fraction ``frac_a`` of a, ``rate_scale`` (v_experiment /
+    v_simulation) and the Taylor-Quinney factor. Writes: ``stress[p]`` (new Cauchy stress),
+    ``eps_p[p] += deps_p``, ``temperature[p] += taylor_quinney * w / (rho cp)`` and, when it
+    flowed, ``sigma_y0[p]`` at the new plastic strain and temperature.
 
     Steps: K, G = Voigt mix of a and b; s = dev(stress[p]); s_trial = R s R^T + 2 G dt dev(sym L)
     with the Hughes-Winget rotation R = (I - dt/2 W)^-1 (I + dt/2 W), W = skew(L) (exactly
@@ -476,7 +493,7 @@ def update_stress(
         1.5 * (n11 * n11 + n22 * n22 + n33 * n33 + 2.0 * (n23 * n23 + n13 * n13 + n12 * n12))
     )
     T = temperature[p]
-    deps, sig_y = return_map(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T)
+    deps, sig_y = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sigma_y0[p])
     w = 0.0
     if deps > 0.0:
         scale = sig_y / q_trial
@@ -491,6 +508,7 @@ def update_stress(
         fb = 1.0 - frac_a
         rho_cp = frac_a * prm_a[I_RHO] * prm_a[I_CP] + fb * prm_b[I_RHO] * prm_b[I_CP]
         temperature[p] = T + taylor_quinney * w / rho_cp
+        sigma_y0[p] = mixed_flow_stress(prm_a, prm_b, frac_a, eps_p[p], 0.0, temperature[p])
 
     minus_p = K * (J - 1.0)  # -p, with p = -K (J - 1)
     stress[p, 0] = n11 + minus_p
@@ -532,6 +550,7 @@ def update_stresses(
     J,
     eps_p,
     temperature,
+    sigma_y0,
     mat_a,
     mat_b,
     frac_a,
@@ -545,7 +564,8 @@ def update_stresses(
 
     Reads ``L_all`` (n, 3, 3), ``J`` (n,), ``mat_a``/``mat_b`` (n,) integer rows of ``table``
     (packed materials), ``frac_a`` (n,). Updates ``stress`` (n, 6), ``eps_p`` (n,),
-    ``temperature`` (n,) in place and writes ``deps_out[i]`` (plastic strain increment) and
+    ``temperature`` (n,), ``sigma_y0`` (n,, the flow stress at rest, see :func:`rest_flow_stresses`) in place
+    and writes ``deps_out[i]`` (plastic strain increment) and
     ``work_out[i]`` (plastic work density, J/m^3).
     """
     n = stress.shape[0]
@@ -558,6 +578,7 @@ def update_stresses(
             J[i],
             eps_p,
             temperature,
+            sigma_y0,
             table[mat_a[i]],
             table[mat_b[i]],
             frac_a[i],
@@ -566,3 +587,15 @@ def update_stresses(
         )
         deps_out[i] = d
         work_out[i] = w
+
+
+@njit(cache=True, parallel=True)
+def rest_flow_stresses(eps_p, temperature, mat_a, mat_b, frac_a, table, sigma_y0):
+    """The flow stress at rest sigma_y(eps_p, 0, T) of every particle (the cache ``update_stress`` keeps).
+
+    Reads eps_p, temperature, the materials (``mat_a``/``mat_b`` rows of ``table``, ``frac_a``);
+    writes ``sigma_y0[i]`` = :func:`mixed_flow_stress` at zero plastic strain rate. Each particle
+    writes only its own entry.
+    """
+    for i in prange(eps_p.shape[0]):
+        sigma_y0[i] = mixed_flow_stress(table[mat_a[i]], table[mat_b[i]], frac_a[i], eps_p[i], 0.0, temperature[i])

@@ -50,7 +50,6 @@ import math
 
 from numba import njit
 
-from plough.mpm.constitutive import mixed_flow_stress
 from plough.mpm.grid import GHOST, MIRROR
 from plough.mpm.shape import bspline2, bspline2_grad
 
@@ -93,13 +92,14 @@ def _pick(k, v0, v1, v2):
 
 
 @njit(cache=True)
-def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, mat_b, frac_a, table, near, origin,
-                           dx, shape, centre, radius, mirror_j0, cbuf, p_lo, p_hi):
+def scatter_contact_stress(x, stress, mass, vol0, J, sigma_y0, near, origin, dx, shape, centre, radius, mirror_j0, cbuf,
+                           p_lo, p_hi):
     """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
     sphere onto nearby nodes.
 
-    Reads particle x, stress, mass, vol0, J, eps_p, temperature, materials and ``near`` (set by
-    g2p) of the active particles p_lo <= p < p_hi. For nodes within one cell of the sphere surface (or inside it) writes
+    Reads particle x, stress, mass, vol0, J, the flow stress at rest ``sigma_y0`` (kappa = sigma_y0 /
+    sqrt 3, the shear strength) and ``near`` (set by g2p) of the active particles p_lo <= p < p_hi.
+    For nodes within one cell of the sphere surface (or inside it) writes
     cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m,
     cbuf[node, 8] = max(cbuf[node, 8], dx - gap) over its particles (gap = distance from the
     particle's face, half a particle size from its centre, to the sphere surface) and
@@ -123,8 +123,7 @@ def scatter_contact_stress(x, stress, mass, vol0, J, eps_p, temperature, mat_a, 
         vol = vol0[p] * J[p]
         # proximity dx - gap of the particle's face to the sphere surface (> 0 within one cell)
         prox = dx - (math.sqrt(q0 * q0 + q1 * q1 + q2 * q2) - radius - 0.5 * vol ** (1.0 / 3.0))
-        kappa = mixed_flow_stress(table[mat_a[p]], table[mat_b[p]], frac_a[p], eps_p[p], 0.0,
-                                  temperature[p]) / SQRT3
+        kappa = sigma_y0[p] / SQRT3
         gx = (x[p, 0] - origin[0]) * inv_dx
         gy = (x[p, 1] - origin[1]) * inv_dx
         gz = (x[p, 2] - origin[2]) * inv_dx

@@ -36,7 +36,7 @@ from plough.materials import (
     ProportionalShear,
 )
 from plough.mpm import contact, transfers
-from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
+from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials, rest_flow_stresses
 from plough.mpm.grid import Grid, boundary_flags, make_grid, mirror_plane_index
 from plough.mpm.particles import Particles, seed_particles
 from plough.mpm.scene import Scene
@@ -188,6 +188,8 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     if scene.layers.coated:
         rows["coating"] = 0
     particles = seed_particles(scene, rows, table[:, I_RHO])
+    rest_flow_stresses(particles.eps_p, particles.temperature, particles.mat_a, particles.mat_b, particles.frac_a,
+                       table, particles.sigma_y0)
 
     disc = scene.discretisation
     dx = disc.cell_size_m
@@ -263,9 +265,8 @@ def step(s: State, c: Constants) -> None:
                   z.p_lo, z.p_hi, z.n_lo, z.n_hi)
     transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v, c.shape, c.mirror_j0, z.n_lo, z.n_hi,
                           z.i_free_lo, z.i_free_hi)
-    contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.eps_p, p.temperature, p.mat_a, p.mat_b,
-                                   p.frac_a, c.table, p.near, g.origin, g.dx, c.shape, sph.centre, c.sphere_radius,
-                                   c.mirror_j0, w.cbuf, z.p_lo, z.p_hi)
+    contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.sigma_y0, p.near, g.origin, g.dx, c.shape,
+                                   sph.centre, c.sphere_radius, c.mirror_j0, w.cbuf, z.p_lo, z.p_hi)
     contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, w.last_push, s.step, c.contact_hold_steps, g.origin,
                            g.dx, c.shape, sph.centre, c.sphere_radius, sph.velocity, c.dt, c.interface_model,
                            c.interface_params, w.contact_out)
@@ -277,9 +278,9 @@ def step(s: State, c: Constants) -> None:
     if c.project_dilatation:
         transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0, z.n_lo, z.n_hi)
     transfers.g2p_update(g.origin, g.dx, c.dt, c.shape, p.x, p.v, w.v_grid, p.C, p.stress, p.J, p.vol0, p.mass,
-                         p.eps_p, p.temperature, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale, c.taylor_quinney,
-                         sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc, z.check_lo_m, z.check_hi_m,
-                         w.grid_div, c.project_dilatation, w.L_buf, z.p_lo, z.p_hi)
+                         p.eps_p, p.temperature, p.sigma_y0, p.mat_a, p.mat_b, p.frac_a, c.table, c.rate_scale,
+                         c.taylor_quinney, sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc, z.check_lo_m,
+                         z.check_hi_m, w.grid_div, c.project_dilatation, w.L_buf, z.p_lo, z.p_hi)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
