@@ -84,6 +84,7 @@ def drive(mat: Material, L: np.ndarray, dt: float, nsteps: int, rate_scale: floa
     eps_p = np.zeros(1)
     temp = np.full(1, T_ROOM)
     sy0 = rest(prm, prm, 1.0, eps_p, temp)  # carried through the steps: update_stress keeps it current
+    deps_last = np.zeros(1)  # so is the return map's starting guess
     F = np.eye(3)
     step = np.eye(3) + dt * L
     hist = {k: [] for k in ("vm", "eps_p", "deps", "w", "T_before", "T_after", "J")}
@@ -91,7 +92,7 @@ def drive(mat: Material, L: np.ndarray, dt: float, nsteps: int, rate_scale: floa
         F = step @ F
         J = float(np.linalg.det(F))
         T_before = float(temp[0])
-        deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, prm, prm, 1.0, rate_scale, tq)
+        deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, deps_last, prm, prm, 1.0, rate_scale, tq)
         assert sy0[0] == c.flow_stress(prm, float(eps_p[0]), 0.0, float(temp[0]))  # the cache stays exact
         hist["vm"].append(von_mises(stress[0]))
         hist["eps_p"].append(float(eps_p[0]))
@@ -304,7 +305,8 @@ def test_elastic_below_yield() -> None:
     eps_p = np.zeros(1)
     temp = np.full(1, T_ROOM)
     J = 1.0 + np.trace(eps)
-    deps, w = c.update_stress(stress, 0, eps / dt, dt, J, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), prm, prm,
+    deps, w = c.update_stress(stress, 0, eps / dt, dt, J, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), np.zeros(1),
+                              prm, prm,
                               1.0, 0.01, 0.9)
     dev = eps - np.trace(eps) / 3 * np.eye(3)
     expect = voigt(2 * G * dev + K * np.trace(eps) * np.eye(3))
@@ -348,7 +350,7 @@ def test_rigid_rotation_preserves_invariants() -> None:
     temp = np.full(1, T_ROOM)
     sy0 = rest(prm, prm, 1.0, eps_p, temp)
     for _ in range(n):
-        c.update_stress(stress, 0, W, dt, J, eps_p, temp, sy0, prm, prm, 1.0, 0.01, 0.9)
+        c.update_stress(stress, 0, W, dt, J, eps_p, temp, sy0, np.zeros(1), prm, prm, 1.0, 0.01, 0.9)
     assert von_mises(stress[0]) == pytest.approx(75e6, rel=1e-12)
     assert pressure(stress[0]) == pytest.approx(p0, rel=1e-12)
     assert eps_p[0] == 0.0 and temp[0] == T_ROOM
@@ -369,7 +371,8 @@ def test_rotation_direction_matches_spin() -> None:
     dt = 1e-5
     stress = voigt(s0)[None, :].copy()
     eps_p, temp = np.zeros(1), np.full(1, T_ROOM)
-    c.update_stress(stress, 0, W, dt, 1.0, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), prm, prm, 1.0, 1.0, 0.9)
+    c.update_stress(stress, 0, W, dt, 1.0, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), np.zeros(1), prm, prm, 1.0,
+                    1.0, 0.9)
     Q = _rodrigues(w, dt)
     exact = Q @ s0 @ Q.T
     first = dt * (W @ s0 - s0 @ W)
@@ -423,6 +426,25 @@ def test_return_map_residual_strong_rate(
         assert sy - expected_flow(mat, eps + d, 0.0, T) > 1e-3 * over
 
 
+@pytest.mark.parametrize("name", [*MATERIALS, *(f"strong_{k}" for k in STRONG_RATE)])
+@pytest.mark.parametrize("guess", [1e-6, 0.3, 0.999, 1.001, 3.0, 1e3, 1e9])
+def test_return_map_guess_changes_the_start_not_the_root(name: str, guess: float) -> None:
+    """A starting guess (the particle's last increment), near the root, far from it or outside the
+    bracket, gives the root found without one, within the return map's own tolerance."""
+    mat = STRONG_RATE[name.removeprefix("strong_")] if name.startswith("strong_") else MATERIALS[name]
+    prm = c.pack_material(mat)
+    G = mat.shear_modulus_Pa
+    eps, T, dt, rate_scale = 0.05, 320.0, 1e-6, 0.01
+    sig0 = c.flow_stress(prm, eps, 0.0, T)
+    for over in (1e-4, 1e-2, 0.3):
+        q = sig0 * (1.0 + over)
+        d, sy = c.return_map_at_rest(prm, prm, 1.0, q, G, eps, dt, rate_scale, T, sig0, 0.0)
+        d_g, sy_g = c.return_map_at_rest(prm, prm, 1.0, q, G, eps, dt, rate_scale, T, sig0, guess * d)
+        assert d > 0.0
+        assert abs(q - 3 * G * d_g - sy_g) <= c.RETURN_RTOL * q
+        assert d_g == pytest.approx(d, rel=1e-9)
+
+
 def test_return_map_elastic_and_zero_stress() -> None:
     prm = c.pack_material(ZINC_BULK)
     G = ZINC_BULK.shear_modulus_Pa
@@ -450,8 +472,8 @@ def test_adiabatic_heating(frac_a: float) -> None:
     eps_p = np.full(1, eps0)
     temp = np.full(1, T0)
     deps, w = c.update_stress(
-        stress, 0, np.zeros((3, 3)), dt, 1.0, eps_p, temp, rest(pa, pb, frac_a, eps_p, temp), pa, pb, frac_a,
-        rate_scale, tq
+        stress, 0, np.zeros((3, 3)), dt, 1.0, eps_p, temp, rest(pa, pb, frac_a, eps_p, temp), np.zeros(1), pa, pb,
+        frac_a, rate_scale, tq
     )
     rate = deps / dt * rate_scale
     sy = frac_a * expected_flow(a, eps0 + deps, rate, T0) + (1 - frac_a) * expected_flow(
@@ -482,7 +504,9 @@ def test_parallel_driver_matches_single_updates() -> None:
     dt, rs, tq = 1e-6, 0.01, 0.9
     sy0 = np.zeros(n)
     c.rest_flow_stresses(eps_p, temp, mat_a, mat_b, frac_a, table, sy0)
-    ref = (stress.copy(), eps_p.copy(), temp.copy(), sy0.copy())
+    # a guess for half the particles: some near the root, some far off, some outside the bracket
+    deps_last = np.where(rng.random(n) < 0.5, 10.0 ** rng.uniform(-12, -2, n), 0.0)
+    ref = (stress.copy(), eps_p.copy(), temp.copy(), sy0.copy(), deps_last.copy())
     ref_d, ref_w = np.zeros(n), np.zeros(n)
     for i in range(n):
         ref_d[i], ref_w[i] = c.update_stress(
@@ -494,6 +518,7 @@ def test_parallel_driver_matches_single_updates() -> None:
             ref[1],
             ref[2],
             ref[3],
+            ref[4],
             table[mat_a[i]],
             table[mat_b[i]],
             frac_a[i],
@@ -501,8 +526,8 @@ def test_parallel_driver_matches_single_updates() -> None:
             tq,
         )
     d, w = np.zeros(n), np.zeros(n)
-    c.update_stresses(stress, L_all, dt, J, eps_p, temp, sy0, mat_a, mat_b, frac_a, table, rs, tq, d, w)
-    for got, want in zip((stress, eps_p, temp, sy0, d, w), (*ref, ref_d, ref_w), strict=True):
+    c.update_stresses(stress, L_all, dt, J, eps_p, temp, sy0, deps_last, mat_a, mat_b, frac_a, table, rs, tq, d, w)
+    for got, want in zip((stress, eps_p, temp, sy0, deps_last, d, w), (*ref, ref_d, ref_w), strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-14, atol=0)
     assert (d > 0).sum() > n // 4  # the random states exercise the plastic branch
 
@@ -543,7 +568,8 @@ def test_property_never_outside_yield_surface(
     eps_p = np.full(1, eps0)
     temp = np.full(1, T0)
     sy0 = rest(TABLE[ia], TABLE[ib], frac, eps_p, temp)
-    deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, TABLE[ia], TABLE[ib], frac, rs, 0.9)
+    deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, np.zeros(1), TABLE[ia], TABLE[ib], frac, rs,
+                              0.9)
     assert np.all(np.isfinite(stress)) and math.isfinite(deps) and math.isfinite(w)
     assert math.isfinite(temp[0]) and temp[0] >= T0
     assert deps >= 0.0 and w >= 0.0 and eps_p[0] == pytest.approx(eps0 + deps, rel=1e-15)

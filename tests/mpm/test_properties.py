@@ -131,8 +131,8 @@ def run_update(state: dict, s_old: np.ndarray, L: np.ndarray, dt: float, rate_sc
     eps_p = np.full(1, state["eps0"])
     temp = np.full(1, state["T0"])
     sy0 = np.array([c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])])
-    deps, w = c.update_stress(stress, 0, np.ascontiguousarray(L), dt, state["J"], eps_p, temp, sy0, ROW[state["a"]],
-                              ROW[state["b"]], state["frac"], rate_scale, TQ)
+    deps, w = c.update_stress(stress, 0, np.ascontiguousarray(L), dt, state["J"], eps_p, temp, sy0, np.zeros(1),
+                              ROW[state["a"]], ROW[state["b"]], state["frac"], rate_scale, TQ)
     # the cache of the flow stress at rest follows the new plastic strain and temperature exactly
     assert sy0[0] == c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])
     return stress[0], float(eps_p[0]), float(temp[0]), deps, w
@@ -227,8 +227,8 @@ def test_pure_spin_preserves_invariants(state, wdir, log_w, log_dt, nsteps):
     temp = np.full(1, state["T0"])
     sy0 = np.array([c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])])
     for _ in range(nsteps):
-        deps, wp = c.update_stress(stress, 0, W, dt, state["J"], eps_p, temp, sy0, ROW[state["a"]], ROW[state["b"]],
-                                   state["frac"], 1.0, TQ)
+        deps, wp = c.update_stress(stress, 0, W, dt, state["J"], eps_p, temp, sy0, np.zeros(1), ROW[state["a"]],
+                                   ROW[state["b"]], state["frac"], 1.0, TQ)
         assert deps == 0.0 and wp == 0.0
     assert eps_p[0] == state["eps0"] and temp[0] == state["T0"]
     assert np.all(np.isfinite(stress))

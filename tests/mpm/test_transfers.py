@@ -151,9 +151,9 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
     sigma_y0 = np.zeros(n)
     rest_flow_stresses(eps_p, temperature, mat, mat, frac, table, sigma_y0)
-    tr.g2p_update(ORIGIN, DX, dt, SHAPE, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, sigma_y0, mat, mat,
-                  frac, table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi, grid_div, project,
-                  tr.allocate_velocity_gradient_scratch(n_chunks), 0, x.shape[0])
+    tr.g2p_update(ORIGIN, DX, dt, SHAPE, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, sigma_y0,
+                  np.zeros(n), mat, mat, frac, table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi,
+                  grid_div, project, tr.allocate_velocity_gradient_scratch(n_chunks), 0, x.shape[0])
     return acc, near, eps_p
 
 

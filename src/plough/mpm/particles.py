@@ -36,6 +36,7 @@ class Particles:
     eps_p: np.ndarray  # (n,) equivalent plastic strain
     temperature: np.ndarray  # (n,) K
     sigma_y0: np.ndarray  # (n,) flow stress at rest sigma_y(eps_p, 0, T), Pa: a cache, filled by solver.init
+    deps_last: np.ndarray  # (n,) plastic strain increment of the particle's last plastic step (return-map guess)
     mat_a: np.ndarray  # (n,) int32 material row
     mat_b: np.ndarray  # (n,) int32 second material row (straddling particles)
     frac_a: np.ndarray  # (n,) volume fraction of mat_a
@@ -80,7 +81,7 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
     return Particles(
         x=x, v=np.zeros((n, 3)), C=np.zeros((n, 3, 3)), stress=np.zeros((n, 6)), J=np.ones(n), vol0=vol0,
         mass=mass, eps_p=np.zeros(n), temperature=np.full(n, scene.outputs.initial_temperature_K),
-        sigma_y0=np.full(n, np.nan),
+        sigma_y0=np.full(n, np.nan), deps_last=np.zeros(n),
         mat_a=mat_a, mat_b=mat_b, frac_a=frac_a, near=np.zeros(n, dtype=np.int8), z0=x[:, 2].copy(),
     )
 

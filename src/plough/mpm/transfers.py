@@ -350,9 +350,9 @@ def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_
 
 
 @njit(cache=True, parallel=True)
-def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, sigma_y0, mat_a,
-               mat_b, frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc, grid_lo,
-               grid_hi, grid_div, project, L_buf, p_lo, p_hi):
+def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, sigma_y0, deps_last,
+               mat_a, mat_b, frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc,
+               grid_lo, grid_hi, grid_div, project, L_buf, p_lo, p_hi):
     """Update the stress (eq. 6.1-6.2), advect, and check the particle state.
 
     Works on the active particles p_lo <= p < p_hi only. Reads particle v, v_grid and C (from
@@ -360,8 +360,9 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
     step, radius sphere_r) and, if ``project`` is 1, the projected nodal dilatation grid_div
     (``grid_dilatation``): J and the pressure then follow L_bar = C + (sum w d_i - tr C) I / 3,
     formed in the chunk's scratch L_buf[c]; with ``project`` 0 they follow C (grid_div and L_buf
-    are not read). Writes particle x (x += dt v_grid), J, stress, eps_p, temperature, sigma_y0 (the
-    flow stress at rest, updated where the particle flowed), near (1 if
+    are not read). Writes particle x (x += dt v_grid), J, stress, eps_p, temperature, sigma_y0 and
+    deps_last (the flow stress at rest and the last plastic increment, updated where the particle
+    flowed), near (1 if
     within near_dist of the sphere surface), and per-chunk accumulators acc[c, :] (plastic work,
     kinetic and elastic energy, adiabatic heat, deepest penetration of a particle centre into the
     sphere, worst instability code and the particle showing it). Each particle writes only its own
@@ -389,8 +390,8 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
             J[p] = J_new
             pa = table[mat_a[p]]
             pb = table[mat_b[p]]
-            deps, w_pl = update_stress(stress, p, L, dt, J_new, eps_p, temperature, sigma_y0, pa, pb, frac_a[p],
-                                       rate_scale, taylor_quinney)
+            deps, w_pl = update_stress(stress, p, L, dt, J_new, eps_p, temperature, sigma_y0, deps_last, pa, pb,
+                                       frac_a[p], rate_scale, taylor_quinney)
             vol = vol0[p] * J_new
             wp_sum += w_pl * vol
             heat_sum += taylor_quinney * w_pl * vol
