@@ -16,6 +16,10 @@ With ``numerics.active_zone_contact_radii`` set, each run's particle-steps are t
 zone works on (plough.study.cost), and the throughput is scaled by the zoned runs' particle-steps
 worked on per second over the same scenes' runs without a zone (median over
 benchmarks/results/active_zone.json, zone as configured).
+Runs whose layers use the real materials' flow laws (hardening, rate terms, heating: Figs. 14-23)
+go at the real-materials' share of the constant-flow throughput measured on the same block
+(benchmarks/results/material_cost.json, ``benchmarks/material_cost.py``); the rigid-plastic runs
+at the reference throughput.
 Writes benchmarks/results/reproduction_time.json and prints a Markdown table.
 """
 
@@ -29,6 +33,7 @@ from pathlib import Path
 
 import yaml
 
+from plough.materials import ConstantFlow
 from plough.mpm.scene import Scene
 from plough.study import cost, matrix
 
@@ -68,6 +73,7 @@ def main() -> None:
     parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
     parser.add_argument("--graded-measured", default=str(ROOT / "benchmarks" / "results" / "graded_particles.json"))
     parser.add_argument("--zone-measured", default=str(ROOT / "benchmarks" / "results" / "active_zone.json"))
+    parser.add_argument("--material-measured", default=str(ROOT / "benchmarks" / "results" / "material_cost.json"))
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
     args = parser.parse_args()
     config = yaml.safe_load(Path(args.config).read_text())
@@ -86,35 +92,52 @@ def main() -> None:
         print(f"active zone: throughput x {zone_factor:.3f} (particle-steps worked on per second, zoned over "
               f"every particle, {args.zone_measured})")
         throughput *= zone_factor
+    material_factor = json.loads(Path(args.material_measured).read_text())["real_over_constant_throughput"]
+    print(f"real materials: throughput x {material_factor:.3f} (real over constant flow stresses on the same block, "
+          f"{args.material_measured})")
     by_size: dict[float, dict[str, float]] = {}
     with_skip = copy.deepcopy(config)
     with_skip["mpm"]["skip_finest_tolerance"] = 0.05
     skippable = matrix.skippable_runs(with_skip)
     skippable_s = 0.0
-    for rid, scene in matrix.all_runs(config).items():
-        c = cost.estimate(Scene.from_dict(scene))
+    by_family = {"rigid-plastic": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0},
+                 "real materials": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0}}
+    for rid, scene_dict in matrix.all_runs(config).items():
+        scene = Scene.from_dict(scene_dict)
+        c = cost.estimate(scene)
+        real = not all(isinstance(m.flow, ConstantFlow) for m in scene.layers.materials)
+        seconds = c.particle_steps / (throughput * (material_factor if real else 1.0))
         if rid in skippable:
-            skippable_s += c.particle_steps / throughput
-        h = round(scene["discretisation"]["particle_size_m"] * 1e6, 6)
-        row = by_size.setdefault(h, {"runs": 0, "particle_steps": 0.0, "largest_run_particles": 0})
+            skippable_s += seconds
+        h = round(scene.discretisation.particle_size_m * 1e6, 6)
+        row = by_size.setdefault(h, {"runs": 0, "particle_steps": 0.0, "largest_run_particles": 0, "projected_s": 0.0})
         row["runs"] += 1
         row["particle_steps"] += c.particle_steps
+        row["projected_s"] += seconds
         row["largest_run_particles"] = max(row["largest_run_particles"], c.particles)
-    print(f"throughput used: {throughput / 1e6:.2f} M particle-steps/s (measured, 2 threads)\n")
+        fam = by_family["real materials" if real else "rigid-plastic"]
+        fam["runs"] += 1
+        fam["particle_steps"] += c.particle_steps
+        fam["projected_s"] += seconds
+    print(f"throughput used: {throughput / 1e6:.2f} M particle-steps/s for rigid-plastic runs, "
+          f"{throughput * material_factor / 1e6:.2f} M for real-material runs (measured, 2 threads)\n")
     print("| h (um) | runs | particle-steps | largest run (particles) | projected wall time |")
     print("|---|---|---|---|---|")
     total = 0.0
     for h in sorted(by_size, reverse=True):
         row = by_size[h]
-        row["projected_s"] = row["particle_steps"] / throughput
         total += row["projected_s"]
         print(f"| {h:g} | {row['runs']} | {row['particle_steps']:.3g} | {row['largest_run_particles']:,} | "
               f"{row['projected_s'] / 3600:.1f} h |")
     print(f"| all | {sum(r['runs'] for r in by_size.values())} | | | {total / 3600:.1f} h ({total / 86400:.1f} days) |")
     print(f"\nwith skip_finest_tolerance, if all {len(skippable)} skippable finest runs are skipped: "
           f"{(total - skippable_s) / 3600:.1f} h (lower bound)")
+    for name, fam in by_family.items():
+        print(f"{name}: {fam['runs']} runs, {fam['particle_steps']:.3g} particle-steps, "
+              f"{fam['projected_s'] / 3600:.1f} h")
     out = {"config": args.config, "throughput_particle_steps_per_s": throughput,
            "graded_throughput_factor": graded_factor, "active_zone_throughput_factor": zone_factor,
+           "real_material_throughput_factor": material_factor, "by_family": by_family,
            "active_zone_contact_radii": numerics.get("active_zone_contact_radii"),
            "graded": bool(numerics.get("graded", False)), "by_size_um": by_size,
            "total_projected_s": total, "skippable_runs": len(skippable),

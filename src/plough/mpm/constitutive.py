@@ -198,10 +198,16 @@ def flow_stress_slopes(prm, eps_p, rate, T):
         c = prm[I_BVL_C]
         dsm = prm[I_BVL_DSIGMA_M]
         y = -math.expm1(-omega * e1)
-        sig = prm[I_BVL_SIGMA_F0] + dsm * (prm[I_BVL_BETA] * e1 + y**c)
-        e1s = max(e1, SLOPE_EPS_FLOOR)
-        ys = -math.expm1(-omega * e1s)
-        dse = dsm * (prm[I_BVL_BETA] + c * ys ** (c - 1.0) * omega * math.exp(-omega * e1s))
+        yc = y**c
+        sig = prm[I_BVL_SIGMA_F0] + dsm * (prm[I_BVL_BETA] * e1 + yc)
+        # the slopes reuse the powers and exponentials of the value (y^(c-1) = y^c / y,
+        # exp(-omega e1) = 1 - y): this function runs in every Newton step of the return map
+        if e1 >= SLOPE_EPS_FLOOR and y > 0.0:
+            dse = dsm * (prm[I_BVL_BETA] + c * (yc / y) * omega * (1.0 - y))
+        else:
+            e1s = max(e1, SLOPE_EPS_FLOOR)
+            ys = -math.expm1(-omega * e1s)
+            dse = dsm * (prm[I_BVL_BETA] + c * ys ** (c - 1.0) * omega * math.exp(-omega * e1s))
         dsr = 0.0
         if rate > 0.0:
             kt = prm[I_BVL_KB] * T / prm[I_BVL_DG0]
@@ -209,14 +215,19 @@ def flow_stress_slopes(prm, eps_p, rate, T):
             if x > 0.0:
                 m = prm[I_BVL_M]
                 sv0 = prm[I_BVL_SIGMA_V0]
-                sig += sv0 * x**m
-                dsr = sv0 * m * max(x, SLOPE_EPS_FLOOR) ** (m - 1.0) * kt / rate
+                xm = x**m
+                sig += sv0 * xm
+                if x >= SLOPE_EPS_FLOOR:
+                    dsr = sv0 * m * (xm / x) * kt / rate
+                else:
+                    dsr = sv0 * m * SLOPE_EPS_FLOOR ** (m - 1.0) * kt / rate
         return sig, dse, dsr
     elif model == FLOW_JC:
         B = prm[I_JC_B]
         p = prm[I_JC_P]
-        h = prm[I_JC_A] + B * eps**p
-        dh = B * p * max(eps, SLOPE_EPS_FLOOR) ** (p - 1.0)
+        ep = eps**p
+        h = prm[I_JC_A] + B * ep
+        dh = B * p * (ep / eps if eps >= SLOPE_EPS_FLOOR else SLOPE_EPS_FLOOR ** (p - 1.0))
         rate0 = prm[I_JC_RATE0]
         rf = 1.0
         drf = 0.0
@@ -233,7 +244,8 @@ def flow_stress_slopes(prm, eps_p, rate, T):
         E = prm[I_PL_E]
         n = prm[I_PL_N]
         base = 1.0 + E * eps / s0
-        return s0 * base**n, n * E * base ** (n - 1.0), 0.0
+        bn = base**n
+        return s0 * bn, n * E * bn / base, 0.0
     return math.nan, math.nan, math.nan
 
 
