@@ -37,14 +37,15 @@ def bytes_per_particle_step(n_particles: int, n_nodes: int, n_chunks: int) -> di
     """Bytes a step moves per particle: the particle arrays each kernel reads and writes, and the grid.
 
     P2G reads x (3), v (3), C (9), stress (6), vol0, J, mass (3 scalars): 24 float64; G2P reads x,
-    C, stress, J, vol0, mass, eps_p, temperature, mat_a/mat_b/frac_a (about 26 values) and writes
-    x, v, C, stress, J, eps_p, temperature, near (about 25); its two passes (kinematics, then the
+    C, stress, J, vol0, mass, eps_p, temperature, sigma_y0, deps_last, mat_a/mat_b/frac_a (about 28
+    values) and writes x, v, C, stress, J, near (about 22; eps_p, temperature, sigma_y0 and
+    deps_last only where a particle flows, not counted); its two passes (kinematics, then the
     update) also write and read the grid velocity at the particle (6) and read x again (3). The
     grid: P2G writes n_chunks copies of 4 values per node, the grid update reads them and writes m
     and v (4), the dilatation projection writes and reads n_chunks copies of 2 values and writes
     the nodal dilatation (1), G2P reads v and the dilatation (4).
     """
-    particle = 8 * (24 + 26 + 25 + 9)
+    particle = 8 * (24 + 28 + 22 + 9)
     grid = 8 * n_nodes * (n_chunks * 4 * 2 + 4 + n_chunks * 2 * 2 + 1 + 4) / n_particles
     return {"particle_bytes": particle, "grid_bytes": grid, "total_bytes": particle + grid}
 

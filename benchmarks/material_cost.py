@@ -1,6 +1,6 @@
 """What the real materials' flow laws cost per particle-step, against constant flow stresses on the same block.
 
-    python benchmarks/material_cost.py [--h-um 10] [--steps 200] [--rounds 3] [--out FILE]
+    python benchmarks/material_cost.py [--h-um 10] [--steps 200] [--rounds 3] [--threads 2] [--out FILE]
 
 The zinc-coated steel scene (examples/zinc_coated_steel.yaml: power-law coating, eq. 7.3, on
 Bergstrom-van Liempt DX56, eq. 7.1, with rate terms and adiabatic heating) on its sized block,

@@ -453,8 +453,11 @@ def _scatter_block(x, h, centre, radius, mirror_j0=-1):
     """The contact buffer of lattice particles x (cubes of edge h grid units, unstressed, all near)."""
     n = x.shape[0]
     ones = np.ones(n)
+    sigma_y0 = np.zeros(n)
+    rest_flow_stresses(np.zeros(n), np.full(n, 298.0), np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones,
+                       pack_materials([rigid_plastic("sub", 900e6, coating=False)]), sigma_y0)
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, np.full(n, 300e6),
+    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, sigma_y0,
                               np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, mirror_j0, cbuf, 0, n)
     return cbuf
 

@@ -5,7 +5,8 @@ finite results, the stress never outside the yield surface at the updated state,
 plastic strain increments and plastic work, elastic steps that leave the plastic strain alone,
 the linear equation of state for the pressure, the consistency condition of the radial return
 (against a trial state computed here with numpy), objectivity under pure spin and frame
-indifference under a rotated frame.
+indifference under a rotated frame; each with a random starting guess of the return map (none, or
+anything from 1e-14 to 10), which must not move the result off the consistency condition.
 
 Contact (``sphere_contact``) on random grid states with FREE, FIXED, MIRROR and GHOST nodes:
 impenetrability, slips that never reverse or grow, untouched ghosts that do not influence the
@@ -114,6 +115,8 @@ def particles(draw) -> dict:
     state["p_old"] = draw(st.floats(-3e9, 3e9))  # the old pressure must play no role
     state["ratio"] = draw(st.one_of(st.just(0.0), st.floats(1e-6, 0.999)))  # q0 / sigma_y(eps0, rate 0, T0)
     state["dir"] = draw(unit6)
+    # the return map's starting guess (the particle's last plastic increment): none, or anything
+    state["guess"] = draw(st.one_of(st.just(0.0), st.floats(1e-14, 10.0)))
     return state
 
 
@@ -131,8 +134,10 @@ def run_update(state: dict, s_old: np.ndarray, L: np.ndarray, dt: float, rate_sc
     eps_p = np.full(1, state["eps0"])
     temp = np.full(1, state["T0"])
     sy0 = np.array([c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])])
-    deps, w = c.update_stress(stress, 0, np.ascontiguousarray(L), dt, state["J"], eps_p, temp, sy0, np.zeros(1),
+    deps_last = np.full(1, state["guess"])
+    deps, w = c.update_stress(stress, 0, np.ascontiguousarray(L), dt, state["J"], eps_p, temp, sy0, deps_last,
                               ROW[state["a"]], ROW[state["b"]], state["frac"], rate_scale, TQ)
+    assert deps_last[0] == (deps if deps > 0.0 else state["guess"])
     # the cache of the flow stress at rest follows the new plastic strain and temperature exactly
     assert sy0[0] == c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])
     return stress[0], float(eps_p[0]), float(temp[0]), deps, w

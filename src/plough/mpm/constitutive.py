@@ -23,7 +23,7 @@ Material data are packed (Python level, :func:`pack_material`) into float64 rows
 
 Rates seen by the flow-stress functions are PHYSICAL equivalent plastic strain rates (1/s); the
 simulated rate is multiplied by ``rate_scale = v_experiment / v_simulation`` inside
-:func:`return_map`. Stress is stored in Voigt order xx, yy, zz, yz, xz, xy.
+:func:`return_map_at_rest`. Stress is stored in Voigt order xx, yy, zz, yz, xz, xy.
 
 All per-particle kernels work on scalars only (no heap allocation), so they can run inside a
 ``prange`` loop over millions of particles.
@@ -63,6 +63,7 @@ __all__ = [
     "rest_flow_stresses",
     "return_map",
     "return_map_at_rest",
+    "non_softening",
     "update_stress",
     "update_stresses",
 ]
@@ -339,41 +340,66 @@ def mixed_moduli(prm_a, prm_b, frac_a):
 def return_map(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T):
     """Radial return of J2 plasticity: the plastic strain increment of one particle.
 
-    :func:`return_map_at_rest` with the flow stress at rest sigma_y(eps_p, 0, T) evaluated here.
+    :func:`return_map_at_rest` with the flow stress at rest sigma_y(eps_p, 0, T) evaluated here
+    and no starting guess; returns ``(d, sigma_y)``.
     """
-    return return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T,
-                              mixed_flow_stress(prm_a, prm_b, frac_a, eps_p, 0.0, T), 0.0)
+    d, sig, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T,
+                                   mixed_flow_stress(prm_a, prm_b, frac_a, eps_p, 0.0, T), 0.0)
+    return d, sig
+
+
+@njit(cache=True)
+def non_softening(prm):
+    """True if the packed law's flow stress never falls with plastic strain or rate (reads ``prm``).
+
+    Then the return map's residual falls monotonically in the increment and its root is unique,
+    so a starting guess cannot lead to another root. A JC rate constant C < 0 (or negative
+    hardening moduli) is accepted by the materials data and makes the law softening.
+    """
+    model = int(prm[I_MODEL])
+    if model == FLOW_BVL:
+        return prm[I_BVL_DSIGMA_M] >= 0.0 and prm[I_BVL_BETA] >= 0.0 and prm[I_BVL_SIGMA_V0] >= 0.0
+    if model == FLOW_JC:
+        return prm[I_JC_B] >= 0.0 and prm[I_JC_C] >= 0.0
+    if model == FLOW_POWER:
+        return prm[I_PL_E] >= 0.0 and prm[I_PL_N] >= 0.0
+    return True
 
 
 @njit(cache=True)
 def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, T, sig0, d_guess):
-    """Radial return of J2 plasticity, given the flow stress at rest ``sig0`` = sigma_y(eps_p, 0, T)
-    and a guess ``d_guess`` of the increment (0: none).
-
-    The solver keeps ``sig0`` per particle (``sigma_y0``, :func:`rest_flow_stresses`): it changes
-    only when the particle flows, so an elastic step (most particles on most steps) costs no
-    flow-stress evaluation; the result is the same to the bit as evaluating it here. The guess is
-    the particle's increment on its last plastic step (``deps_last``): where a rate term takes up
-    most of the overstress the root lies orders of magnitude below the elastic-predictor bound and
-    the Newton iteration from that bound needs 7-10 evaluations (DX56 at the physical rates of the
-    real-material scenes); from the last increment of a steadily flowing particle, two or three.
-    A guess outside the bracket is ignored; the root and its tolerance are those without a guess.
+    """Radial return of J2 plasticity, given the flow stress at rest and a guess of the increment.
 
     Reads the packed rows, ``frac_a``, the trial von Mises stress ``q_trial`` (Pa), shear modulus
     ``G``, plastic strain ``eps_p``, time step ``dt`` (simulated s), ``rate_scale`` (= v_experiment
-    / v_simulation, turns simulated into physical rates) and ``T`` (K); writes nothing.
+    / v_simulation, turns simulated into physical rates), ``T`` (K), the flow stress at rest
+    ``sig0`` = sigma_y(eps_p, 0, T) (Pa) and a starting guess ``d_guess`` of the increment (0:
+    none); writes nothing.
 
-    Elastic if q_trial <= sigma_y(eps_p, rate 0, T): returns ``(0.0, that sigma_y)``. Otherwise
-    solves  f(d) = q_trial - 3 G d - sigma_y(eps_p + d, d / dt * rate_scale, T) = 0  for d >= 0 with
-    a safeguarded Newton iteration (full slope df/dd = -3G - dsigma/deps - dsigma/drate *
-    rate_scale / dt; steps taken in ln d) started at the right end of the bracket
-    [0, (q_trial - sigma_y(eps_p, 0, T)) / (3G)] (f > 0 at the left end, f <= 0 at the right one
-    for non-softening laws), bisecting when a Newton step leaves the shrinking bracket, until
-    |f| <= RETURN_RTOL * q_trial (or the bracket has collapsed to round-off).
-    Returns ``(d, sigma_y(eps_p + d, d / dt * rate_scale, T))``.
+    Elastic if q_trial <= sig0: returns ``(0.0, sig0, 0)``. Otherwise solves
+    f(d) = q_trial - 3 G d - sigma_y(eps_p + d, d / dt * rate_scale, T) = 0  for d >= 0 with a
+    safeguarded Newton iteration (full slope df/dd = -3G - dsigma/deps - dsigma/drate *
+    rate_scale / dt; steps taken in ln d) on the bracket [0, (q_trial - sig0) / (3G)] (f > 0 at
+    the left end, f <= 0 at the right one for non-softening laws; widened to q_trial / (3G) for
+    softening ones), bisecting when a Newton step leaves the shrinking bracket, until
+    |f| <= RETURN_RTOL * q_trial (or the bracket has collapsed to round-off). The iteration
+    starts at the bracket's right end, or at ``d_guess`` if that lies inside the bracket and the
+    laws are non-softening (:func:`non_softening`: the root is then unique, so the guess changes
+    the start, not the root beyond the tolerance).
+    Returns ``(d, sigma_y(eps_p + d, d / dt * rate_scale, T), flow-law evaluations)``.
+
+    Why the two inputs: the solver keeps ``sig0`` per particle (``sigma_y0``,
+    :func:`rest_flow_stresses`), which changes only when the particle flows, so an elastic step
+    (most particles on most steps) costs no flow-law evaluation, and the result is the same to
+    the bit as evaluating it here. The guess is the particle's increment on its last plastic step
+    (``deps_last``): where a rate term takes up most of the overstress the root lies orders of
+    magnitude below the elastic-predictor bound (about 300x for DX56 at the physical rates of the
+    real-material scenes) and the Newton steps from that bound take 8-9 evaluations; from a guess
+    within 1% of the root, five (the bound, the guess and three Newton steps), within 10%, five
+    or six.
     """
     if q_trial <= sig0:
-        return 0.0, sig0
+        return 0.0, sig0, 0
     three_g = 3.0 * G
     rate_per_d = rate_scale / dt
     tol = RETURN_RTOL * q_trial
@@ -381,20 +407,24 @@ def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, 
     hi = (q_trial - sig0) / three_g
     x = hi
     sig, dse, dsr = mixed_flow_stress_slopes(prm_a, prm_b, frac_a, eps_p + x, x * rate_per_d, T)
+    evals = 1
     f = q_trial - three_g * x - sig
     if f > tol:
         # only for softening laws (e.g. a JC rate constant C < 0): widen to the full return
         hi = q_trial / three_g
         x = hi
         sig, dse, dsr = mixed_flow_stress_slopes(prm_a, prm_b, frac_a, eps_p + x, x * rate_per_d, T)
+        evals += 1
         f = q_trial - three_g * x - sig
         if f > 0.0:  # flow stress <= 0 there: the deviator vanishes
-            return x, max(sig, 0.0)
+            return x, max(sig, 0.0), evals
     df = -three_g - dse - dsr * rate_per_d
-    if abs(f) > tol and 0.0 < d_guess < hi:
-        hi = x  # f <= 0 here: the bracket is [0, hi] whichever side of the root the guess falls
+    if abs(f) > tol and 0.0 < d_guess < hi and non_softening(prm_a) and non_softening(prm_b):
+        # f(hi) < 0 and f(0) > 0 still bracket the root; the loop below narrows the bracket
+        # from the guess's side
         x = d_guess
         sig, dse, dsr = mixed_flow_stress_slopes(prm_a, prm_b, frac_a, eps_p + x, x * rate_per_d, T)
+        evals += 1
         f = q_trial - three_g * x - sig
         df = -three_g - dse - dsr * rate_per_d
     for it in range(RETURN_MAX_ITER):
@@ -407,9 +437,10 @@ def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, 
         if hi - lo <= 1e-15 * hi:
             break
         # Newton step in u = ln d: the residual is close to linear in ln d where the rate term or
-        # eps^p hardening dominate, and concave in ln d for the laws here, so from the right end
-        # of the bracket these steps approach the root monotonically even when it lies orders of
-        # magnitude below the elastic-predictor bound.
+        # eps^p hardening dominate, and concave in ln d for the laws here, so from the right of
+        # the root these steps approach it monotonically even when it lies orders of magnitude
+        # below the elastic-predictor bound; from its left (a guess below the root) a step
+        # overshoots to its right, and the bracket catches a step that leaves it.
         # Every evaluation shrinks the bracket; after RETURN_MAX_NEWTON steps (never reached in
         # practice) only bisection, in ln d once the bracket is away from 0, is left.
         xn = -1.0
@@ -422,9 +453,10 @@ def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, 
             xn = math.sqrt(lo * hi) if lo > 0.0 else 0.5 * hi
         x = xn
         sig, dse, dsr = mixed_flow_stress_slopes(prm_a, prm_b, frac_a, eps_p + x, x * rate_per_d, T)
+        evals += 1
         f = q_trial - three_g * x - sig
         df = -three_g - dse - dsr * rate_per_d
-    return x, sig
+    return x, sig, evals
 
 
 # ----------------------------------------------------------------------------- stress update
@@ -447,7 +479,8 @@ def update_stress(
 
     Steps: K, G = Voigt mix of a and b; s = dev(stress[p]); s_trial = R s R^T + 2 G dt dev(sym L)
     with the Hughes-Winget rotation R = (I - dt/2 W)^-1 (I + dt/2 W), W = skew(L) (exactly
-    orthogonal); q_trial = sqrt(3/2 s:s); :func:`return_map` at the start-of-step temperature;
+    orthogonal); q_trial = sqrt(3/2 s:s); :func:`return_map_at_rest` at the start-of-step
+    temperature, from the cached ``sigma_y0[p]`` and the guess ``deps_last[p]``;
     s *= sigma_y / q_trial if plastic; p = -K (J - 1); stress[p] = s - p I. The volumetric heat
     capacity of a mixed particle is frac_a rho_a cp_a + (1 - frac_a) rho_b cp_b (= mixed density
     times mass-weighted cp).
@@ -519,8 +552,8 @@ def update_stress(
         1.5 * (n11 * n11 + n22 * n22 + n33 * n33 + 2.0 * (n23 * n23 + n13 * n13 + n12 * n12))
     )
     T = temperature[p]
-    deps, sig_y = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sigma_y0[p],
-                                     deps_last[p])
+    deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sigma_y0[p],
+                                        deps_last[p])
     w = 0.0
     if deps > 0.0:
         scale = sig_y / q_trial

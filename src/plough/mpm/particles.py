@@ -21,6 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from plough.mpm.constitutive import I_RHO, rest_flow_stresses
 from plough.mpm.scene import Scene
 
 
@@ -35,7 +36,7 @@ class Particles:
     mass: np.ndarray  # (n,) mass including mass scaling, kg
     eps_p: np.ndarray  # (n,) equivalent plastic strain
     temperature: np.ndarray  # (n,) K
-    sigma_y0: np.ndarray  # (n,) flow stress at rest sigma_y(eps_p, 0, T), Pa: a cache, filled by solver.init
+    sigma_y0: np.ndarray  # (n,) flow stress at rest sigma_y(eps_p, 0, T), Pa: a cache update_stress keeps
     deps_last: np.ndarray  # (n,) plastic strain increment of the particle's last plastic step (return-map guess)
     mat_a: np.ndarray  # (n,) int32 material row
     mat_b: np.ndarray  # (n,) int32 second material row (straddling particles)
@@ -48,11 +49,12 @@ class Particles:
         return self.x.shape[0]
 
 
-def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.ndarray) -> Particles:
+def seed_particles(scene: Scene, material_rows: dict[str, int], table: np.ndarray) -> Particles:
     """Lattice particles of the scene's block with their materials.
 
-    ``material_rows`` maps 'coating'/'substrate' to rows of the packed material table and
-    ``densities`` gives each row's physical density (kg/m^3).
+    ``material_rows`` maps 'coating'/'substrate' to rows of the packed material ``table``
+    (:func:`plough.mpm.constitutive.pack_materials`), which gives each row's physical density and
+    the flow stress at rest the particles start with.
     """
     h = scene.discretisation.particle_size_m
     x = _lattice(scene, int(round(scene.domain.length_m / h)))
@@ -76,12 +78,16 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], densities: np.nd
         frac[frac < 1e-9] = 0.0
         mat_a[frac > 0] = coat
         frac_a = np.where(frac > 0, frac, 1.0)
+    densities = table[:, I_RHO]
     rho = frac_a * densities[mat_a] + (1.0 - frac_a) * densities[mat_b]
     mass = rho * scene.discretisation.mass_scaling * vol0
+    eps_p = np.zeros(n)
+    temperature = np.full(n, scene.outputs.initial_temperature_K)
+    sigma_y0 = np.empty(n)
+    rest_flow_stresses(eps_p, temperature, mat_a, mat_b, frac_a, table, sigma_y0)
     return Particles(
         x=x, v=np.zeros((n, 3)), C=np.zeros((n, 3, 3)), stress=np.zeros((n, 6)), J=np.ones(n), vol0=vol0,
-        mass=mass, eps_p=np.zeros(n), temperature=np.full(n, scene.outputs.initial_temperature_K),
-        sigma_y0=np.full(n, np.nan), deps_last=np.zeros(n),
+        mass=mass, eps_p=eps_p, temperature=temperature, sigma_y0=sigma_y0, deps_last=np.zeros(n),
         mat_a=mat_a, mat_b=mat_b, frac_a=frac_a, near=np.zeros(n, dtype=np.int8), z0=x[:, 2].copy(),
     )
 

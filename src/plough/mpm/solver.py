@@ -36,7 +36,7 @@ from plough.materials import (
     ProportionalShear,
 )
 from plough.mpm import contact, transfers
-from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials, rest_flow_stresses
+from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
 from plough.mpm.grid import Grid, boundary_flags, make_grid, mirror_plane_index
 from plough.mpm.particles import Particles, seed_particles
 from plough.mpm.scene import Scene
@@ -187,9 +187,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     rows = {"substrate": len(mats) - 1}
     if scene.layers.coated:
         rows["coating"] = 0
-    particles = seed_particles(scene, rows, table[:, I_RHO])
-    rest_flow_stresses(particles.eps_p, particles.temperature, particles.mat_a, particles.mat_b, particles.frac_a,
-                       table, particles.sigma_y0)
+    particles = seed_particles(scene, rows, table)
 
     disc = scene.discretisation
     dx = disc.cell_size_m
