@@ -469,13 +469,13 @@ def update_stress(
     Reads: ``stress[p]`` ((n, 6) Voigt xx, yy, zz, yz, xz, xy; only its deviator is used), ``L``
     ((3, 3) velocity gradient of the particle, L[i, j] = dv_i/dx_j), ``dt``, ``J`` (det F after
     this step), ``eps_p[p]``, ``temperature[p]``, ``sigma_y0[p]`` (the flow stress at rest
-    sigma_y(eps_p[p], 0, temperature[p]), kept by :func:`rest_flow_stresses`), ``deps_last[p]`` (the
-    particle's plastic strain increment on its last plastic step, 0 before it first flowed: the
-    return map's starting guess), the packed rows
-    ``prm_a``/``prm_b`` with volume fraction ``frac_a`` of a, ``rate_scale`` (v_experiment /
-    v_simulation) and the Taylor-Quinney factor. Writes: ``stress[p]`` (new Cauchy stress),
-    ``eps_p[p] += deps_p``, ``temperature[p] += taylor_quinney * w / (rho cp)`` and, when it
-    flowed, ``sigma_y0[p]`` at the new plastic strain and temperature and ``deps_last[p] = deps_p``.
+    sigma_y(eps_p[p], 0, temperature[p]), kept by :func:`rest_flow_stresses`), ``deps_last[p]``
+    (the particle's plastic strain increment on its last plastic step, 0 before it first flowed:
+    the return map's starting guess), the packed rows ``prm_a``/``prm_b`` with volume fraction
+    ``frac_a`` of a, ``rate_scale`` (v_experiment / v_simulation) and the Taylor-Quinney factor.
+    Writes: ``stress[p]`` (new Cauchy stress), ``eps_p[p] += deps_p``, ``temperature[p] +=
+    taylor_quinney * w / (rho cp)`` and, when it flowed, ``sigma_y0[p]`` at the new plastic strain
+    and temperature and ``deps_last[p] = deps_p``.
 
     Steps: K, G = Voigt mix of a and b; s = dev(stress[p]); s_trial = R s R^T + 2 G dt dev(sym L)
     with the Hughes-Winget rotation R = (I - dt/2 W)^-1 (I + dt/2 W), W = skew(L) (exactly
@@ -626,9 +626,9 @@ def update_stresses(
 
     Reads ``L_all`` (n, 3, 3), ``J`` (n,), ``mat_a``/``mat_b`` (n,) integer rows of ``table``
     (packed materials), ``frac_a`` (n,). Updates ``stress`` (n, 6), ``eps_p`` (n,),
-    ``temperature`` (n,), ``sigma_y0`` (n,, the flow stress at rest, see :func:`rest_flow_stresses`),
-    ``deps_last`` (n,, the last plastic increment) in place and writes ``deps_out[i]`` (plastic strain increment) and
-    ``work_out[i]`` (plastic work density, J/m^3).
+    ``temperature`` (n,), ``sigma_y0`` (n,; the flow stress at rest, see :func:`rest_flow_stresses`)
+    and ``deps_last`` (n,; the last plastic increment) in place and writes ``deps_out[i]`` (plastic
+    strain increment) and ``work_out[i]`` (plastic work density, J/m^3).
     """
     n = stress.shape[0]
     for i in prange(n):
