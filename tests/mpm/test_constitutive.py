@@ -470,6 +470,23 @@ def test_return_map_guess_near_the_root_saves_evaluations() -> None:
         assert n_warm <= n_cold - saved
 
 
+@pytest.mark.parametrize("mat", [ZINC_COATING, ZINC_BULK], ids=["power", "jc"])
+def test_return_map_guess_costs_nothing_where_the_root_is_near_the_bound(mat: Material) -> None:
+    """Without a strong rate term the root lies within a few per cent of the elastic-predictor
+    bound and Newton from there needs 3-5 evaluations; a guess below the root would cost more (9
+    from half the root), so the return map does not take it: the same count with or without."""
+    prm = c.pack_material(mat)
+    G = mat.shear_modulus_Pa
+    eps, T, dt, rate_scale = 0.1, 300.0, 9.7e-7, 0.01
+    sig0 = c.flow_stress(prm, eps, 0.0, T)
+    for over in (1e-4, 1e-2, 1e-1):
+        q = sig0 * (1.0 + over)
+        d, _, n_cold = c.return_map_at_rest(prm, prm, 1.0, q, G, eps, dt, rate_scale, T, sig0, 0.0)
+        assert n_cold <= 5
+        for factor in (0.5, 0.9, 0.99):
+            assert c.return_map_at_rest(prm, prm, 1.0, q, G, eps, dt, rate_scale, T, sig0, factor * d)[2] == n_cold
+
+
 def test_return_map_ignores_the_guess_of_a_softening_law() -> None:
     """A JC rate constant C < 0 softens with rate: the root need not be unique, so the guess is not
     used and the result is that without a guess, to the bit."""
