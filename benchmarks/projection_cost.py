@@ -67,7 +67,7 @@ def main() -> None:
     def update(project: int) -> None:
         tr.g2p_update(origin, dx, 1e-9, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature,
                       sigma_y0, np.zeros(n), mat, mat, frac, table, 1.0, 0.9, far, 1e-6, 3 * dx, near, acc, lo, hi,
-                      grid_div, project, L_buf, 0, n)
+                      grid_div, project, L_buf, 0, n, tr.G2P_BLOCK)
 
     def step(project: int) -> None:
         kinematics(project)

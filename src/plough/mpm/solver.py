@@ -278,7 +278,8 @@ def step(s: State, c: Constants) -> None:
     transfers.g2p_update(g.origin, g.dx, c.dt, c.shape, p.x, p.v, w.v_grid, p.C, p.stress, p.J, p.vol0, p.mass,
                          p.eps_p, p.temperature, p.sigma_y0, p.deps_last, p.mat_a, p.mat_b, p.frac_a, c.table,
                          c.rate_scale, c.taylor_quinney, sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc,
-                         z.check_lo_m, z.check_hi_m, w.grid_div, c.project_dilatation, w.L_buf, z.p_lo, z.p_hi)
+                         z.check_lo_m, z.check_hi_m, w.grid_div, c.project_dilatation, w.L_buf, z.p_lo, z.p_hi,
+                         transfers.G2P_BLOCK)
     account_energy(w)
     check_stability(s, c)
     control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
