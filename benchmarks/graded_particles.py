@@ -19,7 +19,9 @@ shorter wall time. Scenes:
 many expected contact radii (``discretisation.active_zone_contact_radii``; README, *Active zone*).
 ``--paper`` adds the paper's numerical setup (``Scene.with_paper_settings()``: its fixed block,
 uniform particles) at each size, for the speed-up of the defaults against it at equal error.
-``--sizes`` replaces the scenes' two sizes; ``--skip-uniform`` runs the graded cases only (the
+``--shapes square disc`` runs every graded case with each fine-zone cross-section
+(``discretisation.fine_zone_shape``). ``--sizes`` replaces the scenes' two sizes; ``--skip-uniform``
+runs the graded cases only (the
 uncoated reference at h = 2.5 um: ``--scenes uncoated --sizes 2.5 --k 1.5 --skip-uniform --out
 benchmarks/results/graded_uncoated_h2.5.json``).
 
@@ -44,22 +46,23 @@ SCENES = {"coated": ("coated_rigid_plastic.yaml", (10.0, 5.0)),
           "real": ("zinc_coated_steel.yaml", (20.0, 10.0))}
 
 
-def scene_at(example: str, h_um: float, k: float | str | None, zone: float | None = None) -> Scene:
-    """Uniform (k None), graded with fine zone k, or the paper's settings (k "paper") at size h_um;
-    with an active zone of ``zone`` expected contact radii if given."""
+def scene_at(example: str, h_um: float, k: float | str | None, zone: float | None = None,
+             shape: str = "square") -> Scene:
+    """Uniform (k None), graded with fine zone k of cross-section ``shape``, or the paper's settings (k
+    "paper") at size h_um; with an active zone of ``zone`` expected contact radii if given."""
     base = Scene.from_yaml(ROOT / "examples" / example)
     disc = replace(base.discretisation, particle_size_m=h_um * 1e-6, active_zone_contact_radii=zone)
     if k == "paper":
         return replace(base, discretisation=disc).with_paper_settings()
     if k is not None:
-        disc = replace(disc, graded=True, fine_zone_contact_radii=float(k))
+        disc = replace(disc, graded=True, fine_zone_contact_radii=float(k), fine_zone_shape=shape)
     return replace(base, discretisation=disc).with_sized_domain()
 
 
-def label(k: float | str | None, zone: float | None = None) -> str:
+def label(k: float | str | None, zone: float | None = None, shape: str = "square") -> str:
     if k == "paper":
         return "paper's settings"
-    name = "uniform" if k is None else f"graded k={k:g}"
+    name = "uniform" if k is None else f"graded k={k:g}" + ("" if shape == "square" else f" {shape}")
     return name if zone is None else f"{name} zone {zone:g}"
 
 
@@ -93,6 +96,9 @@ def main() -> None:
     parser.add_argument("--paper", action="store_true", help="also the paper's numerical setup")
     parser.add_argument("--zones", nargs="+", type=float, default=[], help="active zones (contact radii) added to "
                         "the graded run of the first --k")
+    parser.add_argument("--shapes", nargs="+", choices=["square", "disc"], default=["square"],
+                        help="fine-zone cross-sections of the graded runs (and of the zoned ones)")
+    parser.add_argument("--zones-only", action="store_true", help="of the graded runs only those with a --zones zone")
     parser.add_argument("--skip-uniform", action="store_true", help="graded runs only (e.g. at h = 2.5 um)")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "graded_particles.json")
     args = parser.parse_args()
@@ -103,12 +109,15 @@ def main() -> None:
         runs[name] = {}
         for h in args.sizes or sizes:
             runs[name][str(h)] = {}
-            cases = [*([] if args.skip_uniform else [(None, None)]), *((k, None) for k in args.k),
-                     *((args.k[0], z) for z in args.zones), *([("paper", None)] if args.paper else [])]
-            for k, zone in cases:
-                row = run_scene(scene_at(example, h, k, zone), args.threads)
-                runs[name][str(h)][label(k, zone)] = row
-                print(f"{name} h = {h} um {label(k, zone)}: {row['particles']:,} particles, {row['wall_s']:.1f} s, "
+            cases = [*([] if args.skip_uniform else [(None, None, "square")]),
+                     *([] if args.zones_only else ((k, None, sh) for k in args.k for sh in args.shapes)),
+                     *((args.k[0], z, sh) for z in args.zones for sh in args.shapes),
+                     *([("paper", None, "square")] if args.paper else [])]
+            for k, zone, shape in cases:
+                row = run_scene(scene_at(example, h, k, zone, shape), args.threads)
+                runs[name][str(h)][label(k, zone, shape)] = row
+                print(f"{name} h = {h} um {label(k, zone, shape)}: {row['particles']:,} particles, "
+                      f"{row['wall_s']:.1f} s, "
                       f"mu {row['mu']:.4f}, mu_sh {row['mu_sh']:.4f}, dp {row['dp'] * 1e6:.2f} um", flush=True)
                 args.out.write_text(json.dumps({"threads": args.threads, "runs": runs}, indent=2) + "\n")
     print(summary(runs))

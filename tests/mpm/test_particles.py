@@ -19,17 +19,29 @@ from plough.mpm.scene import Scene
 from .test_scene import coated_scene
 
 
-def graded(scene: Scene, k: float = 1.0) -> Scene:
-    return replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_contact_radii=k))
+def graded(scene: Scene, k: float = 1.0, shape: str = "square") -> Scene:
+    return replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_contact_radii=k,
+                                                 fine_zone_shape=shape))
 
 
-@pytest.fixture(scope="module", params=[True, False], ids=["mirror", "full"])
+def in_zone(x: np.ndarray, half_edge: float, w: float, shape: str) -> np.ndarray:
+    """True where a point of the cube of half-edge ``half_edge`` centred at x lies in the fine zone (reference)."""
+    gap_y = np.maximum(np.abs(x[:, 1]) - half_edge, 0.0)
+    gap_z = np.maximum(-x[:, 2] - half_edge, 0.0)
+    if shape == "square":
+        return (gap_y <= w) & (gap_z <= w)
+    return np.hypot(gap_y, gap_z) <= w
+
+
+@pytest.fixture(scope="module", params=[(True, "square"), (False, "square"), (True, "disc")],
+                ids=["mirror", "full", "mirror-disc"])
 def pair(request):
     """(graded scene, uniform particles, graded particles) of the coated scene, t = 25 um, h = 10 um."""
-    scene = coated_scene(symmetric=request.param)
+    symmetric, shape = request.param
+    scene = coated_scene(symmetric=symmetric)
     uniform, _ = solver.init(scene, n_chunks=1)
-    grad, _ = solver.init(graded(scene), n_chunks=1)
-    return graded(scene), uniform.particles, grad.particles
+    grad, _ = solver.init(graded(scene, shape=shape), n_chunks=1)
+    return graded(scene, shape=shape), uniform.particles, grad.particles
 
 
 def test_graded_seeding_keeps_mass_volume_and_coating_volume(pair):
@@ -50,7 +62,9 @@ def test_fine_zone_is_untouched_and_merged_particles_are_double_size(pair):
     h = scene.discretisation.particle_size_m
     a, _ = scene.expected_contact()
     w = max(scene.discretisation.fine_zone_contact_radii * a, 6 * h)
-    in_zone_u = (np.abs(u.x[:, 1]) - 0.5 * h <= w) & (u.x[:, 2] + 0.5 * h >= -w)
+    shape = scene.discretisation.fine_zone_shape
+    in_zone_u = in_zone(u.x, 0.5 * h, w, shape)
+    assert in_zone_u.sum() > 0
     fine = np.isclose(g.vol0, h**3, rtol=1e-12, atol=0)
     coarse = np.isclose(g.vol0, 8 * h**3, rtol=1e-12, atol=0)
     assert np.all(fine | coarse) and coarse.sum() > 0
@@ -60,7 +74,7 @@ def test_fine_zone_is_untouched_and_merged_particles_are_double_size(pair):
     assert fine.sum() == u.n - 8 * coarse.sum()
     # coarse particles: outside the zone, centred on even lattice planes, inside the half cylinder
     xc = g.x[coarse]
-    assert np.all((np.abs(xc[:, 1]) - h > w - 1e-12) | (xc[:, 2] + h < -w + 1e-12))
+    assert not np.any(in_zone(xc, h - 1e-12, w, shape))
     np.testing.assert_allclose(np.mod(xc / h, 2.0), 1.0, atol=1e-9)
     R = scene.domain.radius_m
     assert np.all(xc[:, 1] ** 2 + xc[:, 2] ** 2 < R * R)
@@ -109,3 +123,24 @@ def test_graded_round_trips_through_the_scene_dict():
     scene = graded(coated_scene(), k=1.25)
     back = Scene.from_dict(scene.to_dict())
     assert back.discretisation.graded is True and back.discretisation.fine_zone_contact_radii == 1.25
+    assert back.discretisation.fine_zone_shape == "square"
+    disc = Scene.from_dict(graded(coated_scene(), shape="disc").to_dict())
+    assert disc.discretisation.fine_zone_shape == "disc"
+
+
+def test_the_disc_zone_is_the_square_zone_less_its_corners():
+    """Same fine particles near the axes, coarse ones in the corners; the mass is kept either way."""
+    scene = coated_scene()
+    sq, _ = solver.init(graded(scene, k=1.0), n_chunks=1)
+    dc, _ = solver.init(graded(scene, k=1.0, shape="disc"), n_chunks=1)
+    s, d = sq.particles, dc.particles
+    assert d.n < s.n
+    assert d.mass.sum() == pytest.approx(s.mass.sum(), rel=1e-12)
+    h = scene.discretisation.particle_size_m
+    fine = lambda p: set(map(tuple, np.rint(p.x[p.vol0 < 2 * h**3] / (0.5 * h)).astype(np.int64)))  # noqa: E731
+    assert fine(d) < fine(s)  # every fine particle of the disc is one of the square's, not the reverse
+
+
+def test_an_unknown_fine_zone_shape_is_refused():
+    with pytest.raises(ValueError, match=r"fine_zone_shape = 'circle' is not one of \['square', 'disc'\]"):
+        replace(coated_scene().discretisation, fine_zone_shape="circle")

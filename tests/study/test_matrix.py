@@ -330,15 +330,18 @@ def test_unknown_figures_are_refused():
 
 
 def test_graded_particles_reach_every_scene_of_the_matrix(config):
-    """numerics.graded / fine_zone_contact_radii go into each run's discretisation (and so into its params)."""
+    """numerics.graded / fine_zone_contact_radii / fine_zone_shape go into each run's discretisation (and so
+    into its params)."""
     changed = copy.deepcopy(config)
+    shape = "disc" if config["mpm"]["numerics"].get("fine_zone_shape", "square") == "square" else "square"
     changed["mpm"]["numerics"].update(graded=not config["mpm"]["numerics"].get("graded", False),
-                                      fine_zone_contact_radii=1.25)
+                                      fine_zone_contact_radii=1.25, fine_zone_shape=shape)
     before, after = matrix.all_runs(config), matrix.all_runs(changed)
     assert set(before) == set(after)
     for rid, d in after.items():
         disc = Scene.from_dict(d).discretisation
         assert disc.graded is changed["mpm"]["numerics"]["graded"] and disc.fine_zone_contact_radii == 1.25
+        assert disc.fine_zone_shape == shape
         assert d != before[rid]  # a changed scene: the workflow reruns it
 
 

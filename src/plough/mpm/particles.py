@@ -61,7 +61,7 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], table: np.ndarra
     n = x.shape[0]
     vol0 = np.full(n, h**3)
     if scene.discretisation.graded:
-        x, vol0 = coarsen_far_field(x, h, _fine_half_width(scene))
+        x, vol0 = coarsen_far_field(x, h, _fine_half_width(scene), scene.discretisation.fine_zone_shape)
         n = x.shape[0]
 
     t = scene.layers.coating_thickness_m
@@ -133,21 +133,32 @@ def particle_count_ratio(scene: Scene) -> float:
         return 1.0
     h = scene.discretisation.particle_size_m
     x = _lattice(scene, 2)
-    return coarsen_far_field(x, h, _fine_half_width(scene))[0].shape[0] / x.shape[0]
+    coarse = coarsen_far_field(x, h, _fine_half_width(scene), scene.discretisation.fine_zone_shape)[0]
+    return coarse.shape[0] / x.shape[0]
 
 
-def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float) -> tuple[np.ndarray, np.ndarray]:
+def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float,
+                      shape: str = "square") -> tuple[np.ndarray, np.ndarray]:
     """Merge the lattice particles outside the fine zone into particles of edge 2 h.
 
     ``x`` are the centres of a lattice of cubes of edge h with faces on multiples of h (y and z
-    measured from the mirror plane and the surface). The fine zone is |y| <= ``fine_half_width_m``
-    and z >= -``fine_half_width_m``; a group of 2 x 2 x 2 cubes (aligned to even multiples of h) is
+    measured from the mirror plane and the surface). A cube is in the fine zone if a point of it
+    is: with ``shape`` "square" where |y| <= ``fine_half_width_m`` and z >= -``fine_half_width_m``,
+    with "disc" where y^2 + z^2 <= ``fine_half_width_m``^2 (z <= 0 in the block); a group of 2 x 2 x 2
+    cubes (aligned to even multiples of h) is
     merged when all eight of its cubes exist and none lies in the fine zone. Returns the new centres
     (sorted x-major, as the lattice was, so that thread chunks stay slabs of the block) and volumes.
     """
     idx = np.floor(x / h).astype(np.int64)  # cube index per axis
     parent = np.floor_divide(idx, 2)
-    fine = (np.abs(x[:, 1]) - 0.5 * h <= fine_half_width_m) & (x[:, 2] + 0.5 * h >= -fine_half_width_m)
+    gap_y = np.maximum(np.abs(x[:, 1]) - 0.5 * h, 0.0)  # from the cube's nearest point to the track's axis
+    gap_z = np.maximum(-x[:, 2] - 0.5 * h, 0.0)
+    if shape == "square":
+        fine = (gap_y <= fine_half_width_m) & (gap_z <= fine_half_width_m)
+    elif shape == "disc":
+        fine = gap_y**2 + gap_z**2 <= fine_half_width_m**2
+    else:
+        raise ValueError(f"fine-zone shape {shape!r} is not one of 'square', 'disc'")
     lo = parent.min(axis=0)
     span = parent.max(axis=0) - lo + 1
     key = ((parent[:, 0] - lo[0]) * span[1] + (parent[:, 1] - lo[1])) * span[2] + (parent[:, 2] - lo[2])

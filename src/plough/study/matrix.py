@@ -254,6 +254,7 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
                                       dilatation=str(numerics.get("dilatation", "projected")),
                                       graded=numerics.get("graded", False),
                                       fine_zone_contact_radii=float(numerics.get("fine_zone_contact_radii", 1.5)),
+                                      fine_zone_shape=str(numerics.get("fine_zone_shape", "square")),
                                       active_zone_contact_radii=_optional_float(
                                           numerics.get("active_zone_contact_radii"))),
         outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
