@@ -3,7 +3,8 @@
     python benchmarks/g2p_balance.py [--blocks 256 1024 4096 16384] [--reps 11] [--threads 2] [--out FILE]
 
 ``transfers.g2p_update`` deals blocks of ``block`` particles to the chunks in turn; ``block`` =
-ceil(n / n_chunks) is the split into contiguous slabs it used before. Plastic particles, whose
+ceil(n / n_chunks) gives one contiguous slab per chunk, the split it used before (for 2 threads
+the slab boundary is at most one particle off the earlier one). Plastic particles, whose
 return map costs several flow-law evaluations, cluster around the sphere, so a slab split can give
 one thread most of them. For each case (a scene, its numerics, how far into the slide) this runs
 the scene to that point, then times ``g2p_update`` alone on the same state (restored before every

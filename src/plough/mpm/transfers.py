@@ -377,8 +377,9 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
     Chunk c works on the blocks of ``block`` particles numbered c, c + n_chunks, c + 2 n_chunks, ...
     (``G2P_BLOCK`` in the solver), not on one contiguous slab: the particles that flow, whose return
     map costs several flow-law evaluations, lie around the sphere, and a slab split gave one thread
-    most of them (zinc-coated steel at h = 10 um: 28.2 against 11.4 ms for the two halves on one
-    thread). ``block`` = ceil(n / n_chunks) is the slab split.
+    most of them (zinc-coated steel at h = 10 um, start of the slide: 29.3 against 12.1 ms for the two
+    halves on one thread, benchmarks/g2p_balance.py). ``block`` = ceil(n / n_chunks) gives one
+    contiguous slab per chunk (the earlier split, whose slab ends could lie one particle off).
     """
     n_chunks = acc.shape[0]
     n_blocks = (p_hi - p_lo + block - 1) // block
