@@ -81,8 +81,8 @@ def main() -> None:
     ratios = [a["particle_steps_per_s"] / b["particle_steps_per_s"]
               for a, b in zip(runs["real materials"], runs["constant flow stress"], strict=True)]
     ratio = statistics.median(ratios)
-    out = {"git_commit": git_commit(), "h_um": args.h_um, "threads": args.threads, "steps_timed": args.steps, "runs": runs,
-           "ratio_per_round": ratios, "real_over_constant_throughput": ratio}
+    out = {"git_commit": git_commit(), "h_um": args.h_um, "threads": args.threads, "steps_timed": args.steps,
+           "runs": runs, "ratio_per_round": ratios, "real_over_constant_throughput": ratio}
     args.out.write_text(json.dumps(out, indent=2) + "\n")
     print(f"real materials run at {ratio:.3f} of the constant-flow throughput (median of {args.rounds} rounds: "
           + ", ".join(f"{x:.3f}" for x in ratios) + f"); {args.out}")
