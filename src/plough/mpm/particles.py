@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from plough.mpm.constitutive import I_RHO, rest_flow_stresses
-from plough.mpm.scene import Scene
+from plough.mpm.scene import FINE_ZONE_SHAPES, Scene
 
 
 @dataclass
@@ -158,7 +158,7 @@ def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float,
     elif shape == "disc":
         fine = gap_y**2 + gap_z**2 <= fine_half_width_m**2
     else:
-        raise ValueError(f"fine-zone shape {shape!r} is not one of 'square', 'disc'")
+        raise ValueError(f"fine-zone shape {shape!r} is not one of {list(FINE_ZONE_SHAPES)}")
     lo = parent.min(axis=0)
     span = parent.max(axis=0) - lo + 1
     key = ((parent[:, 0] - lo[0]) * span[1] + (parent[:, 1] - lo[1])) * span[2] + (parent[:, 2] - lo[2])

@@ -254,7 +254,7 @@ class Discretisation:
     ``fine_zone_shape``: the zone's cross-section, "square" (default: |y| and the depth each
     within the half-width) or "disc" (the distance from the track's centre line on the surface
     within it: the corners, about 2 contact radii from the track in both y and depth, are coarse;
-    14-16% fewer particles on the reference scenes).
+    12-16% fewer particles on the reference scenes; README, "Graded particles").
 
     ``active_zone_contact_radii``: when set, only the particles that started within this many
     expected contact radii (and at least 20 h) behind or ahead of the sphere's centre (along the
