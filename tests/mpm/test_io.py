@@ -218,3 +218,44 @@ def test_a_half_without_normal_force_is_finite_and_not_steady():
 def test_a_window_too_short_to_split_is_not_called_steady():
     out = io.steadiness(_series(np.ones(3), np.ones(3), np.zeros(3)), np.array([False, False, True]), 5e-6)
     assert out == {"mu_drift": 0.0, "material_top_rise": 0.0, "steady": 0}
+
+
+# ----------------------------------------------------------------------------- sampling standard errors
+def test_jackknife_of_a_mean_is_the_batch_means_standard_error():
+    """For the mean over equal batches the delete-one-batch jackknife equals std(batch means) / sqrt(k)
+    exactly; a wrong (k - 1) / k factor or a left-in batch breaks this."""
+    rng = np.random.default_rng(7)
+    x = rng.normal(size=120)
+    se = io.jackknife_standard_error(lambda k: x[k].mean(), x.size, batches=10)
+    batch_means = x.reshape(10, 12).mean(axis=1)
+    assert se == pytest.approx(batch_means.std(ddof=1) / np.sqrt(10), rel=1e-12)
+    assert io.jackknife_standard_error(lambda k: x[k].mean(), 1) is None
+    assert io.jackknife_standard_error(lambda k: x[k].mean(), 3, batches=10) == pytest.approx(
+        x[:3].std(ddof=1) / np.sqrt(3), rel=1e-12)  # fewer samples than batches: one sample a batch
+
+
+def test_standard_errors_of_the_window_and_the_sections():
+    """A constant force has no sampling error; Fx alternating between batch halves of the window
+    gives mu's jackknife error from its two values; records outside the window do not count; dp's
+    error comes from the sections' scatter of depth."""
+    n, k = 40, io.SE_BATCHES
+    mask = np.arange(n) >= 20  # 20 records: 10 batches of 2
+    fz = np.full(n, 2.0)
+    fx = np.where(np.arange(n) < 30, 1.0, 1.4)  # the window's first 5 batches 1.0, last 5 1.4
+    fx[:20] = 99.0
+    series = {"Fx": fx, "Fz": fz, "Fx_pl": 0.25 * fx, "Fx_sh": np.full(n, 0.5)}
+    y = np.array([0.0, 10e-6, 20e-6, 100e-6])
+    depth = np.array([2e-6, 4e-6, 2e-6, 4e-6])  # four sections, two groove depths; pile-up 1 um
+    prof = np.array([[-d, -d, 0.0, 1e-6] for d in depth])
+    out = io.standard_errors(series, mask, y, prof, contact_radius=15e-6)
+    theta = np.array([(fx[20:].sum() - fx[20 + 2 * b: 22 + 2 * b].sum()) / (fz[20:].sum() - 4.0) for b in range(k)])
+    expected = np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2))
+    assert out["mu_standard_error"] == pytest.approx(expected, rel=1e-12) and expected > 0
+    assert out["mu_pl_standard_error"] == pytest.approx(0.25 * expected, rel=1e-12)
+    assert out["mu_sh_standard_error"] == pytest.approx(0.0, abs=1e-15)
+    # dp = mean depth + 1 um; leave one section of four out: depth 8/3 or 10/3 um, two each
+    dp_theta = np.array([10 / 3, 8 / 3, 10 / 3, 8 / 3]) * 1e-6
+    dp_expected = np.sqrt(3 / 4 * np.sum((dp_theta - dp_theta.mean()) ** 2))
+    assert out["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
+    # one section: dp's error cannot be estimated and is left out, not written as NaN or 0
+    assert "dp_standard_error" not in io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6)

@@ -159,6 +159,20 @@ def test_steadiness_is_reported_from_the_run_records(tiny_run, tiny_scene):
     assert int(ds.steady) == int(expected)
 
 
+def test_standard_errors_are_written_from_the_run_records(tiny_run):
+    """mu's sampling error is the jackknife over the window's own records (recomputed here from the
+    file's series), with units; dp's is finite and non-negative."""
+    ds = tiny_run
+    mask = ds.in_steady_window.values
+    series = {q: ds[q].values for q in ("Fx", "Fz", "Fx_pl", "Fx_sh")}
+    idx = np.flatnonzero(mask)
+    fx, fz = series["Fx"][idx], series["Fz"][idx]
+    expected = io.jackknife_standard_error(lambda k: fx[k].sum() / fz[k].sum(), idx.size)
+    assert float(ds.mu_standard_error) == pytest.approx(expected, rel=1e-12)
+    assert ds.mu_standard_error.attrs["units"] == "1" and ds.dp_standard_error.attrs["units"] == "m"
+    assert np.isfinite(float(ds.dp_standard_error)) and float(ds.dp_standard_error) >= 0.0
+
+
 def test_an_unsteady_window_warns_and_a_steady_one_does_not(tiny_run):
     import warnings
 

@@ -21,7 +21,7 @@ import yaml
 
 from plough.figures import plot
 from plough.io import to_json, write_netcdf_atomic
-from plough.mpm.io import SERIES_META, STEADY_META
+from plough.mpm.io import SERIES_META, STANDARD_ERROR_META, STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import Method
 from plough.study.mpm_figures import build_dataset
@@ -80,6 +80,11 @@ def value(o: str, sig: float, h: float, noisy: bool = False) -> float:
     return v
 
 
+def se_value(name: str, sig: float, h: float) -> float:
+    """A fake run's sampling standard error: differs between points and sizes."""
+    return (1e-6 if name.startswith("dp") else 1e-3) * sig * h
+
+
 def fake_run(scene: dict) -> xr.Dataset:
     """A result file as plough.mpm.io.build_dataset writes it, with made-up numbers."""
     h_m = scene["discretisation"]["particle_size_m"]
@@ -112,6 +117,9 @@ def fake_run(scene: dict) -> xr.Dataset:
     for o, (u, ln) in STEADY_META.items():
         ds[o] = ((), value(o, sig, h, noisy), {"units": u, "long_name": ln})
     ds["steady"] = ((), np.int8(not noisy), {"units": "1", "long_name": "steady window (fake: 0 for the noisy runs)"})
+    for name, (u, ln) in STANDARD_ERROR_META.items():
+        if not (noisy and name == "dp_standard_error"):  # a run whose dp error could not be estimated
+            ds[name] = ((), se_value(name, sig, h), {"units": u, "long_name": ln})
     ds.attrs.update(cost_wall_time_s=100.0 / h, scene=to_json(scene),
                     coating_representation=f"fake representation of {scene['name']}",
                     sphere_centre_end_m=np.array([2e-4, 0.0, 4.9e-4]), midplane_section_x_m=1e-4)
@@ -192,6 +200,10 @@ def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path)
             for h in SIZES:
                 assert float(ds["wall_time_s"].sel(sel).sel(h=h)) == pytest.approx(100.0 / h)
                 assert float(ds["steady"].sel(sel).sel(h=h)) == float(not noisy)  # each run's own flag
+                assert float(ds["mu_standard_error"].sel(sel).sel(h=h)) == pytest.approx(
+                    se_value("mu", sig, h), rel=1e-12)
+                dp_se = float(ds["dp_standard_error"].sel(sel).sel(h=h))
+                assert np.isnan(dp_se) if noisy else dp_se == pytest.approx(se_value("dp", sig, h), rel=1e-12)
             expected = matrix.analytical_values(matrix.real_point(real, label, load, r1))
             for o, v in expected.items():
                 assert np.isfinite(v)
@@ -502,3 +514,32 @@ def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
         labels = [line.get_label() for line in crossed if not line.get_label().startswith("_")]
         assert len(labels) == (1 if crosses else 0)
         plt.close(fig)
+
+
+def test_sweep_figure_draws_each_runs_sampling_error(run_files):
+    """Every per-size point gets a bar of +- its run's standard error (none where it was not estimable:
+    the noisy run's dp); files without the errors draw no bars."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from plough.figures import mpm as mpm_figures
+
+    ds = build_dataset(SMOKE, "fig15", run_files)
+    for quantity, scale in (("mu", 1.0), ("dp", 1e6)):
+        fig, ax = plt.subplots()
+        mpm_figures._sweep_panel(ax, ds, quantity, "")
+        half = []  # half-lengths of the per-size bars (the faint ones, alpha 0.3)
+        for container in ax.containers:
+            bars = container.lines[2]
+            if bars and bars[0].get_alpha() == 0.3:
+                half.extend(np.ptp(seg[:, 1]) / 2 for seg in bars[0].get_segments())
+        expected = np.nan_to_num(ds[f"{quantity}_standard_error"].values * scale, nan=0.0)
+        np.testing.assert_allclose(sorted(half), sorted(expected.ravel()), rtol=1e-9)
+        assert (expected == 0).sum() == (len(SIZES) if quantity == "dp" else 0)
+        plt.close(fig)
+    fig, ax = plt.subplots()
+    mpm_figures._sweep_panel(ax, ds.drop_vars(["mu_standard_error"]), "mu", "")
+    assert not [c for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() == 0.3]
+    plt.close(fig)

@@ -1,6 +1,6 @@
 """MPM figures (Figs. 11-21, 23): extrapolated MPM marks with uncertainty bars, per-size values faint
-(crossed where the run's window was not a steady state), analytical lines, the coating-wear region
-shaded where dp > t, and pictures from particle data."""
+with each run's sampling standard error (crossed where the run's window was not a steady state),
+analytical lines, the coating-wear region shaded where dp > t, and pictures from particle data."""
 
 from __future__ import annotations
 
@@ -44,6 +44,7 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
     x = ds[axis].values
     h_values = ds["h"].values
     steady = ds.get(f"steady{suffix}")  # per run; absent for result files from before the check
+    error = ds.get(f"{quantity}_standard_error{suffix}")  # per run (mu, mu_pl, mu_sh, dp); absent in old files
     unsteady_label = "run not steady (mu_drift or prow growth in its window)"
     for i, label in enumerate(ds[series_dim].values):
         colour = SERIES_COLOURS[i % len(SERIES_COLOURS)]
@@ -52,6 +53,9 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
             y = per_size.sel(sel).isel(h=k).values * scale
             ax.plot(x, y, ls="none", marker=SIZE_MARKERS[k % 5], ms=3.5,
                     color=colour, alpha=0.3, label=f"h = {h:g} µm" if i == 0 else None)
+            if error is not None:  # the run's own sampling error; none drawn where it was not estimable
+                yerr = np.nan_to_num(error.sel(sel).isel(h=k).values * scale, nan=0.0)
+                ax.errorbar(x, y, yerr=yerr, ls="none", color=colour, alpha=0.3, elinewidth=0.8)
             if steady is not None:
                 bad = steady.sel(sel).isel(h=k).values == 0
                 if bad.any():
@@ -91,7 +95,8 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
 
 def _scene_note(ds: xr.Dataset) -> str:
     return f"Particle sizes h = {', '.join(f'{h:g}' for h in ds['h'].values)} µm; marks: extrapolated to h -> 0 " \
-           "(Richardson, Roache GCI bars; hollow = fallback, flagged), faint: per size; lines: analytical model."
+           "(Richardson, Roache GCI bars; hollow = fallback, flagged), faint: per size with the run's sampling " \
+           "standard error; lines: analytical model."
 
 
 def _fig11_13(ds: xr.Dataset, outputs, quantity: str, figure: str) -> None:

@@ -7,7 +7,9 @@ mu = mean Fx / mean Fz over the steady window, mu_pl and mu_sh the same with the
 and interface-shear parts of Fx; dp = dg + hpu from the residual cross-sections (Fig. 14c).
 Whether the window is a steady state is checked, not assumed: ``mu_drift`` (mu of the window's
 second half against its first) and ``material_top_rise`` (how far the highest particle rose
-between the halves: a growing prow) give ``steady``.
+between the halves: a growing prow) give ``steady``. ``<name>_standard_error`` (mu, mu_pl, mu_sh,
+dp) are the sampling errors of those means: a delete-one-batch jackknife over contiguous batches
+of the window's records and of the residual sections (README "Lattice phase: the noise of one run").
 
 Snapshots are VTK XML PolyData (.vtp) files, which ParaView and OVITO open.
 """
@@ -16,6 +18,7 @@ from __future__ import annotations
 
 import base64
 import json
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -60,6 +63,15 @@ STEADY_META = {
     "dp": ("m", "ploughing depth dp = dg + hpu"),
     "max_particle_penetration": ("m", "deepest penetration of a particle centre into the sphere (whole run)"),
 }
+
+#: contiguous batches the steady window's records and the residual sections are cut into for the jackknife
+SE_BATCHES = 10
+STANDARD_ERROR_META = {
+    f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over {SE_BATCHES} contiguous "
+                                    "batches of the steady window's records)")
+    for name in ("mu", "mu_pl", "mu_sh")
+} | {"dp_standard_error": ("m", f"sampling standard error of dp (jackknife over {SE_BATCHES} contiguous batches "
+                                "of the residual sections)")}
 
 #: a window is steady when mu moves by at most this fraction between its halves ...
 STEADY_MU_DRIFT = 0.05
@@ -142,6 +154,22 @@ def surface_samples(p: Particles, h: float) -> tuple[np.ndarray, np.ndarray, np.
 def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float,
                       distance_m: float | None = None) -> tuple:
     """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
+    y, prof, sections = section_profiles(p, scene, sphere_x_end, contact_radius, distance_m)
+    return y, _nanmean_rows(prof), sections
+
+
+def _nanmean_rows(prof: np.ndarray) -> np.ndarray:
+    """Mean over the sections (axis 0) ignoring empty bins; NaN where no section has the bin."""
+    count = np.isfinite(prof).sum(axis=0)
+    total = np.where(np.isfinite(prof), prof, 0.0).sum(axis=0)
+    return np.divide(total, count, out=np.full(prof.shape[1], np.nan), where=count > 0)
+
+
+def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float,
+                     distance_m: float | None = None) -> tuple:
+    """Surface height z(y) at each section behind the sphere; (y, z_top per section, sections x).
+
+    z_top has one row per section (NaN in a bin no particle column reaches)."""
     h = scene.discretisation.particle_size_m
     x0 = scene.start_x_m
     d = scene.sliding.distance_m if distance_m is None else distance_m
@@ -173,7 +201,59 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
         profiles.append(z)
     prof = np.array(profiles)
     prof[~np.isfinite(prof)] = np.nan
-    return centres, np.nanmean(prof, axis=0), sections
+    return centres, prof, sections
+
+
+def groove_depths(y: np.ndarray, z_top: np.ndarray, contact_radius: float) -> tuple[float, float]:
+    """(dg, hpu) of a residual profile: the deepest point within 1.5 contact radii of the track's
+    centre line below the original surface, and the highest point above it (each at least 0)."""
+    near_track = np.abs(y) <= 1.5 * contact_radius
+    return float(max(-np.nanmin(z_top[near_track]), 0.0)), float(max(np.nanmax(z_top), 0.0))
+
+
+def jackknife_standard_error(statistic, n: int, batches: int = SE_BATCHES) -> float | None:
+    """Delete-one-batch jackknife standard error of ``statistic(kept indices)`` over ``n`` ordered samples.
+
+    The samples (records of the steady window, or residual sections) are cut into ``min(batches, n)``
+    contiguous batches; each batch is left out in turn. Contiguous batches, not single samples,
+    because neighbouring records are correlated (the force saw-tooths with the prow); the
+    jackknife, not the spread of batch values, because mu is a ratio of means and dp the extreme
+    of a mean profile: nonlinear statistics of the samples. None when fewer than 2 batches or when a
+    leave-one-out value is not finite (a subset without normal force or without a profile).
+    """
+    k = min(batches, n)
+    if k < 2:
+        return None
+    parts = np.array_split(np.arange(n), k)
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # an all-empty bin in a subset: NaN, handled below
+        theta = np.array([statistic(np.concatenate(parts[:b] + parts[b + 1:])) for b in range(k)], dtype=float)
+    if not np.isfinite(theta).all():
+        return None
+    return float(np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2)))
+
+
+def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarray, prof: np.ndarray,
+                    contact_radius: float) -> dict[str, float]:
+    """Sampling standard errors of the steady-state results (``STANDARD_ERROR_META``).
+
+    The steady window is a finite sample of a fluctuating force and the residual groove a finite
+    number of sections: these errors say how far the same run with a different but equally long
+    sample (a perturbation at round-off level) would likely move mu and dp. dp's error is omitted
+    when fewer than 2 sections were measured.
+    """
+    idx = np.flatnonzero(mask)
+    fx, fz = series["Fx"][idx], series["Fz"][idx]
+    out = {}
+    for name, part in (("mu", fx), ("mu_pl", series["Fx_pl"][idx]), ("mu_sh", series["Fx_sh"][idx])):
+        se = jackknife_standard_error(lambda k, part=part: part[k].sum() / fz[k].sum(), idx.size)
+        if se is not None:
+            out[f"{name}_standard_error"] = se
+    se = jackknife_standard_error(lambda k: sum(groove_depths(y, _nanmean_rows(prof[k]), contact_radius)),
+                                  prof.shape[0])
+    if se is not None:
+        out["dp_standard_error"] = se
+    return out
 
 
 def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coating_row: int,
@@ -260,10 +340,9 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         raise SimulationError(f"the sphere lost contact while sliding (mean Fz = {Fz:.3g} N for load_N = "
                               f"{scene.load_N:g} N): inertia dominates; lower sliding.speed_m_s or mass_scaling")
     a_exp, _ = scene.expected_contact()
-    y, z_top, sections = residual_profiles(p, scene, float(sphere_centre[0]), a_exp, slid_total)
-    near_track = np.abs(y) <= 1.5 * a_exp
-    dg = float(max(-np.nanmin(z_top[near_track]), 0.0))
-    hpu = float(max(np.nanmax(z_top), 0.0))
+    y, prof, sections = section_profiles(p, scene, float(sphere_centre[0]), a_exp, slid_total)
+    z_top = _nanmean_rows(prof)
+    dg, hpu = groove_depths(y, z_top, a_exp)
     steady = {
         "mu": Fx / Fz, "mu_pl": series["Fx_pl"][mask].mean() / Fz, "mu_sh": series["Fx_sh"][mask].mean() / Fz,
         "Fz_mean": Fz, "Fx_mean": Fx, "penetration": series["depth"][mask].mean(), "dg": dg, "hpu": hpu,
@@ -285,6 +364,9 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     ds["in_steady_window"] = (("record",), mask, {"units": "1", "long_name": "record lies in the steady window"})
     for name, value in steady.items():
         u, ln = STEADY_META[name]
+        ds[name] = ((), float(value), {"units": u, "long_name": ln})
+    for name, value in standard_errors(series, mask, y, prof, a_exp).items():
+        u, ln = STANDARD_ERROR_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
     for name, value in steadiness(series, mask, scene.discretisation.particle_size_m).items():
         u, ln = STEADINESS_META[name]

@@ -22,7 +22,7 @@ import numpy as np
 import xarray as xr
 
 from plough.io import provenance_attrs
-from plough.mpm.io import STEADINESS_META, STEADY_META
+from plough.mpm.io import STANDARD_ERROR_META, STEADINESS_META, STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import extrapolate_dataarray
 from plough.study.skipping import is_skipped
@@ -77,6 +77,9 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     per_size = {o: np.full(shape, np.nan) for o in (*matrix.OUTPUTS, "Fz_mean", "max_particle_penetration")}
     wall = np.full(shape, np.nan)
     steady = np.full(shape, np.nan)  # stays NaN for skipped runs and files written before the check
+    # sampling errors of each run (plough.mpm.io.standard_errors): NaN where skipped, not estimable, or
+    # written before they were
+    errors = {name: np.full(shape, np.nan) for name in STANDARD_ERROR_META}
     analytical = {o: np.full(shape[:2], np.nan) for o in matrix.ANALYTICAL_OUTPUTS}
     skipped = np.zeros(shape[:2], dtype=bool)
     for i, series in enumerate(panel.series):
@@ -96,6 +99,9 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                 wall[i, j, k] = float(ds.attrs["cost_wall_time_s"])
                 if "steady" in ds:
                     steady[i, j, k] = float(ds["steady"])
+                for name, values in errors.items():
+                    if name in ds:
+                        values[i, j, k] = float(ds[name])
             for o, v in matrix.analytical_values(point).items():
                 analytical[o][i, j] = v
     dims3 = (panel.series_dim, panel.axis, "h")
@@ -130,6 +136,12 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
         out[f"steady{suffix}"] = (dims3, steady, {"units": "1", "allow_missing": 1,
                                                   "long_name": STEADINESS_META["steady"][1] + " (per run; missing: "
                                                   "skipped, or written before the check)"})
+    for name, values in errors.items():
+        if np.isfinite(values).any():
+            units, long_name = STANDARD_ERROR_META[name]
+            out[name + suffix] = (dims3, values, {"units": units, "allow_missing": 1,
+                                                  "long_name": f"{long_name} (per run; missing: skipped, not "
+                                                               "estimable, or written before it was)"})
     out[f"skipped_finest{suffix}"] = ((panel.series_dim, panel.axis), skipped.astype(np.int8),
                                       {"units": "1", "long_name": "finest size skipped (mpm.skip_finest_tolerance): "
                                        "extrapolated from the two coarser sizes"})
