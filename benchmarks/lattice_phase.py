@@ -31,8 +31,8 @@ from plough.io import git_commit
 from plough.mpm.run import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
-KEEP = ("mu", "mu_standard_error", "mu_pl", "mu_sh", "dp", "dp_standard_error", "dg", "hpu", "profile_holes",
-        "Fz_mean", "mu_drift", "material_top_rise", "steady")
+KEEP = ("mu", "mu_standard_error", "mu_pl", "mu_sh", "dp", "dp_standard_error", "dg", "hpu", "Fz_mean", "mu_drift",
+        "material_top_rise", "steady")
 
 
 def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:

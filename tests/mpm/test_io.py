@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import warnings
 from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
@@ -260,44 +259,3 @@ def test_standard_errors_of_the_window_and_the_sections():
     assert out["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
     # one section: dp's error cannot be estimated and is left out, not written as NaN or 0
     assert "dp_standard_error" not in io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6)
-
-
-# ----------------------------------------------------------------------------- holes in the residual sections
-def test_a_column_missing_its_top_particle_is_dropped_not_averaged(scene):
-    """Two layers of particles; the top particle of one column in the groove is carried off, so that
-    section reads the second layer (one particle size lower) there. The hole is dropped: the profile,
-    dg and dp are those of the intact block; without the masking dg would grow by h / n_sections."""
-    h = scene.discretisation.particle_size_m
-    p, xs = _grooved_block(scene, lambda r: np.full(r.shape, 3e-6))
-    below = p.x.copy()
-    below[:, 2] -= h
-    x_end = scene.start_x_m + scene.sliding.distance_m
-    a = 50e-6
-    y, z_intact, sections = residual_profiles(SimpleNamespace(x=np.vstack([p.x, below]), J=np.ones(2 * p.n),
-                                                              vol0=np.full(2 * p.n, h**3), n=2 * p.n), scene, x_end, a)
-    mid = sections[sections.size // 2]
-    gone = np.flatnonzero((np.abs(p.x[:, 0] - mid) < 0.5 * h) & (np.abs(p.x[:, 1] - 0.5 * h) < 1e-12))
-    assert gone.size == 1
-    keep = np.setdiff1d(np.arange(p.n), gone)
-    holed = SimpleNamespace(x=np.vstack([p.x[keep], below]), J=np.ones(keep.size + p.n),
-                            vol0=np.full(keep.size + p.n, h**3), n=keep.size + p.n)
-    _, z_holed, _ = residual_profiles(holed, scene, x_end, a)
-    np.testing.assert_allclose(z_holed, z_intact, rtol=0, atol=1e-18)
-    _, prof, _ = io.section_profiles(holed, scene, x_end, a)
-    masked, n_holes = io.mask_holes(prof, h)
-    assert n_holes == 1 and np.isnan(masked[sections.size // 2, 0])
-    unmasked_dg, _ = io.groove_depths(y, io._nanmean_rows(prof), a)
-    assert unmasked_dg == pytest.approx(3e-6 + h / sections.size, rel=1e-9)  # what the hole did before
-
-
-def test_shallow_dips_and_empty_bins_are_kept():
-    """A dip of less than HOLE_DEPTH_PARTICLES particle sizes below the median is the groove's own
-    variation and stays; a bin no section reaches stays empty without a warning or a dropped count."""
-    h = 10e-6
-    prof = np.array([[-1e-6, np.nan], [-1e-6 - 0.49 * h, np.nan], [-1e-6, np.nan], [-1e-6 - 0.51 * h, np.nan],
-                     [-1e-6, np.nan]])  # median -1 um
-    with warnings.catch_warnings():
-        warnings.simplefilter("error")
-        masked, n = io.mask_holes(prof, h)
-    assert n == 1 and np.isnan(masked[3, 0]) and masked[1, 0] == prof[1, 0]
-    assert np.isnan(masked[:, 1]).all()

@@ -4,9 +4,7 @@ Steady-state results are named as in the analytical model (``mu``, ``mu_pl``, ``
 plus ``dg`` (groove depth below the original surface), ``hpu`` (pile-up height above it) and
 ``penetration`` (depth of the sphere's lowest point under load), so the two compare directly:
 mu = mean Fx / mean Fz over the steady window, mu_pl and mu_sh the same with the normal-traction
-and interface-shear parts of Fx; dp = dg + hpu from the residual cross-sections (Fig. 14c), averaged
-over the sections after dropping holes (a column whose top particle the sphere carried off,
-:func:`mask_holes`).
+and interface-shear parts of Fx; dp = dg + hpu from the residual cross-sections (Fig. 14c).
 Whether the window is a steady state is checked, not assumed: ``mu_drift`` (mu of the window's
 second half against its first) and ``material_top_rise`` (how far the highest particle rose
 between the halves: a growing prow) give ``steady``. ``<name>_standard_error`` (mu, mu_pl, mu_sh,
@@ -66,8 +64,6 @@ STEADY_META = {
     "max_particle_penetration": ("m", "deepest penetration of a particle centre into the sphere (whole run)"),
 }
 
-#: a section's height in a y bin this many particle sizes below the bin's median over the sections is a hole
-HOLE_DEPTH_PARTICLES = 0.5
 #: contiguous batches the steady window's records and the residual sections are cut into for the jackknife
 SE_BATCHES = 10
 STANDARD_ERROR_META = {
@@ -159,25 +155,7 @@ def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_r
                       distance_m: float | None = None) -> tuple:
     """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
     y, prof, sections = section_profiles(p, scene, sphere_x_end, contact_radius, distance_m)
-    prof, _ = mask_holes(prof, scene.discretisation.particle_size_m)
     return y, _nanmean_rows(prof), sections
-
-
-def mask_holes(prof: np.ndarray, particle_size_m: float) -> tuple[np.ndarray, int]:
-    """Drop the holes of the residual sections: (profiles with holes set to NaN, number dropped).
-
-    A hole is one section's height in a y bin more than ``HOLE_DEPTH_PARTICLES`` particle sizes below
-    the median of that bin over the sections: a column whose top particle was carried off by the
-    sphere, so the next particle down (one particle size lower) is read as the surface. They are a
-    particle-scale artefact, not the groove: one to three of the 99 section-bins of the coated scene
-    at h = 20 um, and with the mean over the sections they moved dp between 3.8 and 7.4 um as the
-    sphere's start moved against the lattice (README "Lattice phase: the noise of one run").
-    """
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)  # a bin no section reaches: median NaN, nothing dropped
-        median = np.nanmedian(prof, axis=0)
-    hole = prof < median - HOLE_DEPTH_PARTICLES * particle_size_m
-    return np.where(hole, np.nan, prof), int(hole.sum())
 
 
 def _nanmean_rows(prof: np.ndarray) -> np.ndarray:
@@ -363,7 +341,6 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
                               f"{scene.load_N:g} N): inertia dominates; lower sliding.speed_m_s or mass_scaling")
     a_exp, _ = scene.expected_contact()
     y, prof, sections = section_profiles(p, scene, float(sphere_centre[0]), a_exp, slid_total)
-    prof, holes = mask_holes(prof, scene.discretisation.particle_size_m)
     z_top = _nanmean_rows(prof)
     dg, hpu = groove_depths(y, z_top, a_exp)
     steady = {
@@ -385,10 +362,6 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         ds[name] = var
     ds.attrs.update(pic_extra["attrs"])
     ds["in_steady_window"] = (("record",), mask, {"units": "1", "long_name": "record lies in the steady window"})
-    ds["profile_holes"] = ((), np.int32(holes), {
-        "units": "1", "long_name": f"section-bins of the residual profile dropped as holes (more than "
-        f"{HOLE_DEPTH_PARTICLES:g} particle sizes below the bin's median; of {prof.shape[0]} sections x "
-        f"{prof.shape[1]} bins)"})
     for name, value in steady.items():
         u, ln = STEADY_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
