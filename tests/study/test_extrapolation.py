@@ -9,6 +9,7 @@ from plough.study.extrapolation import (
     Method,
     extrapolate,
     extrapolate_dataarray,
+    sampling_error,
 )
 
 F0 = 0.3
@@ -311,3 +312,63 @@ def test_dataarray_wrapper_two_sizes_and_errors():
         extrapolate_dataarray(da, "size")
     with pytest.raises(ValueError):
         extrapolate_dataarray(xr.DataArray([0.5, 0.45], dims="h"))
+
+
+# ----------------------------------------------------------------------------- sampling error of the limit
+def _jacobian(h, f, **kw):
+    """d value / d f_i by central differences (exact for the fixed-order methods: the value is linear)."""
+    f = np.asarray(f, float)
+    out = []
+    for i in range(f.size):
+        d = np.zeros_like(f)
+        d[i] = 1e-6 * max(abs(f[i]), 1.0)
+        out.append((float(extrapolate(h, f + d, **kw).value) - float(extrapolate(h, f - d, **kw).value)) / (2 * d[i]))
+    return np.array(out)
+
+
+@pytest.mark.parametrize(("h", "f", "method"), [
+    ([2.5, 5.0], [1.30, 1.10], Method.TWO_SIZES_ASSUMED_ORDER),
+    ([10.0, 2.5, 5.0], [1.0, 1.3, 1.4], Method.LEAST_SQUARES),  # oscillating: e21, e32 of opposite sign
+])
+def test_sampling_error_is_the_linear_propagation_of_the_fixed_order_methods(h, f, method):
+    """The value is linear in f at a fixed order: the propagated error equals sqrt(sum (df0/df_i s_i)^2)
+    with the derivatives taken by differencing extrapolate() itself."""
+    ex = extrapolate(h, f)
+    assert int(ex.method) == method
+    s = np.array([0.01, 0.02, 0.03])[: len(h)]
+    expected = np.sqrt(np.sum((_jacobian(h, f) * s) ** 2))
+    assert float(sampling_error(h, ex, s)) == pytest.approx(expected, rel=1e-6)
+    # one size's error alone gives |df0/df_i| s_i
+    for i in range(len(h)):
+        one = np.zeros(len(h))
+        one[i] = 0.05
+        assert float(sampling_error(h, ex, one)) == pytest.approx(abs(_jacobian(h, f)[i]) * 0.05, rel=1e-6, abs=1e-15)
+
+
+def test_sampling_error_of_richardson_holds_the_observed_order():
+    """Richardson at order 1 with r = 2: f0 = 2 f1 - f2, so s0 = sqrt(4 s1^2 + s2^2); the coarsest value
+    enters only through the order, which is held fixed (its error counts nothing)."""
+    h = np.array([2.5, 5.0, 10.0])
+    f = 1.0 + 0.1 * h  # order 1 exactly
+    ex = extrapolate(h, f)
+    assert int(ex.method) == Method.RICHARDSON and float(ex.order) == pytest.approx(1.0)
+    assert float(sampling_error(h, ex, [0.01, 0.02, 0.5])) == pytest.approx(np.sqrt(4 * 0.01**2 + 0.02**2), rel=1e-9)
+    # sizes given in another order: the errors follow their sizes
+    perm = [2, 0, 1]
+    ex_p = extrapolate(h[perm], f[perm])
+    assert float(sampling_error(h[perm], ex_p, np.array([0.01, 0.02, 0.5])[perm])) == pytest.approx(
+        np.sqrt(4 * 0.01**2 + 0.02**2), rel=1e-9)
+
+
+def test_sampling_error_of_converged_missing_and_vectorised_points():
+    h = [2.5, 5.0, 10.0]
+    f = np.array([[1.0, 1.0, 1.0], [1.0 + 0.25, 1.0 + 0.5, 1.0 + 1.0], [np.nan, 1.0, 1.0], [1.25, 1.5, 2.0]])
+    se = np.array([[0.1, 0.2, 0.3], [0.01, 0.02, 0.03], [0.01, 0.02, 0.03], [np.nan, 0.02, 0.03]])
+    ex = extrapolate(h, f)
+    out = sampling_error(h, ex, se)
+    assert out.shape == (4,)
+    assert out[0] == pytest.approx(0.1)  # converged: the finest value's own error
+    assert out[1] == pytest.approx(np.sqrt(4 * 0.01**2 + 0.02**2))
+    assert np.isnan(out[2]) and np.isnan(out[3])  # a missing point; a needed size's error missing
+    with pytest.raises(ValueError, match="standard_error"):
+        sampling_error(h, ex, se[:, :2])

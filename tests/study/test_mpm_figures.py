@@ -204,6 +204,13 @@ def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path)
                     se_value("mu", sig, h), rel=1e-12)
                 dp_se = float(ds["dp_standard_error"].sel(sel).sel(h=h))
                 assert np.isnan(dp_se) if noisy else dp_se == pytest.approx(se_value("dp", sig, h), rel=1e-12)
+            # the runs' errors carried to the limit: Richardson at the observed order, f0 = (1 + g) f1 - g f2
+            h1, h2 = sorted(SIZES)[:2]
+            if not noisy:
+                g = 1.0 / ((h2 / h1) ** float(ds["mu_h0_order"].sel(sel)) - 1.0)
+                expected = np.hypot((1 + g) * se_value("mu", sig, h1), g * se_value("mu", sig, h2))
+                assert float(ds["mu_h0_sampling_error"].sel(sel)) == pytest.approx(expected, rel=1e-9)
+            assert bool(np.isnan(float(ds["dp_h0_sampling_error"].sel(sel)))) == noisy  # a run's dp error missing
             expected = matrix.analytical_values(matrix.real_point(real, label, load, r1))
             for o, v in expected.items():
                 assert np.isfinite(v)
@@ -539,6 +546,15 @@ def test_sweep_figure_draws_each_runs_sampling_error(run_files):
         np.testing.assert_allclose(sorted(half), sorted(expected.ravel()), rtol=1e-9)
         assert (expected == 0).sum() == (len(SIZES) if quantity == "dp" else 0)
         plt.close(fig)
+    # the extrapolated marks' bars: the GCI and the propagated sampling error in quadrature
+    fig, ax = plt.subplots()
+    mpm_figures._sweep_panel(ax, ds, "mu", "")
+    half = sorted(np.ptp(seg[:, 1]) / 2 for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() is None
+                  for seg in c.lines[2][0].get_segments())
+    expected = np.hypot(ds["mu_h0_uncertainty"].values, np.nan_to_num(ds["mu_h0_sampling_error"].values)).ravel()
+    np.testing.assert_allclose(half, sorted(expected), rtol=1e-9)
+    assert np.all(np.asarray(half) > ds["mu_h0_uncertainty"].values.min())
+    plt.close(fig)
     fig, ax = plt.subplots()
     mpm_figures._sweep_panel(ax, ds.drop_vars(["mu_standard_error"]), "mu", "")
     assert not [c for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() == 0.3]

@@ -63,6 +63,9 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
                     unsteady_label = None
         val = ds[f"{quantity}_h0{suffix}"].sel(sel).values * scale
         unc = ds[f"{quantity}_h0_uncertainty{suffix}"].sel(sel).values * scale
+        sampling = ds.get(f"{quantity}_h0_sampling_error{suffix}")
+        if sampling is not None:  # the runs' own noise carried to the limit, in quadrature with the GCI
+            unc = np.hypot(unc, np.nan_to_num(sampling.sel(sel).values * scale, nan=0.0))
         flagged = ds[f"{quantity}_h0_flagged{suffix}"].sel(sel).values.astype(bool)
         ax.errorbar(x[~flagged], val[~flagged], yerr=unc[~flagged], fmt="o", color=colour, capsize=3,
                     label=f"MPM h -> 0, {_label(label)}")
@@ -95,8 +98,9 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
 
 def _scene_note(ds: xr.Dataset) -> str:
     return f"Particle sizes h = {', '.join(f'{h:g}' for h in ds['h'].values)} µm; marks: extrapolated to h -> 0 " \
-           "(Richardson, Roache GCI bars; hollow = fallback, flagged), faint: per size with the run's sampling " \
-           "standard error; lines: analytical model."
+           "(Richardson; bars: Roache GCI and the runs' sampling errors carried to the limit, in quadrature; " \
+           "hollow = fallback, flagged), faint: per size with the run's sampling standard error; " \
+           "lines: analytical model."
 
 
 def _fig11_13(ds: xr.Dataset, outputs, quantity: str, figure: str) -> None:

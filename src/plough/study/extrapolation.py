@@ -63,6 +63,7 @@ __all__ = [
     "Method",
     "extrapolate",
     "extrapolate_dataarray",
+    "sampling_error",
 ]
 
 #: Roache's safety factors: 1.25 when the order is observed (three or more sizes), 3 when assumed.
@@ -276,6 +277,37 @@ def extrapolate(
         flagged=flagged.reshape(shape),
         h=h,
     )
+
+
+def sampling_error(h: ArrayLike, ex: Extrapolation, standard_error: ArrayLike) -> NDArray[np.float64]:
+    """Standard error of ``ex.value`` from independent standard errors of the per-size values.
+
+    Every method writes the extrapolated value as a weighted sum of the per-size values once its
+    order is fixed: Richardson and two sizes ``(1 + g) f1 - g f2`` with ``g = 1 / (r^p - 1)``, the
+    least-squares fit the regression's intercept weights, converged ``f1``. The error is
+    ``sqrt(sum (w_i s_i)^2)``; the scatter the values' noise puts into the observed order itself is
+    not included. ``standard_error`` is ordered like ``h`` and shaped like the ``f`` given to
+    :func:`extrapolate`; NaN where a needed size's error is missing, or the point is missing.
+    """
+    h = _validate_sizes(h)
+    se = np.asarray(standard_error, dtype=float)
+    if se.ndim == 0 or se.shape[-1] != h.size or se.shape[:-1] != ex.value.shape:
+        raise ValueError(f"standard_error (shape {se.shape}) must have the shape of f: {ex.value.shape} + ({h.size},)")
+    hs = h[np.argsort(h)]
+    se = se[..., np.argsort(h)].reshape(-1, h.size)
+    method, order = ex.method.reshape(-1), ex.order.reshape(-1)
+    weights = np.zeros_like(se)
+    weights[:, 0] = 1.0  # converged: the finest value
+    fixed = (method == Method.RICHARDSON) | (method == Method.TWO_SIZES_ASSUMED_ORDER)
+    g = 1.0 / ((hs[1] / hs[0]) ** order[fixed] - 1.0)
+    weights[fixed, 0], weights[fixed, 1] = 1.0 + g, -g
+    for row in np.flatnonzero(method == Method.LEAST_SQUARES):
+        x = hs ** order[row]
+        weights[row] = 1.0 / h.size - x.mean() * (x - x.mean()) / np.sum((x - x.mean()) ** 2)
+    used = weights != 0.0
+    out = np.sqrt(np.sum(np.where(used, weights * se, 0.0) ** 2, axis=-1))
+    out[np.any(used & ~np.isfinite(se), axis=-1) | (method == Method.MISSING)] = np.nan
+    return out.reshape(ex.value.shape)
 
 
 def extrapolate_dataarray(

@@ -4,10 +4,11 @@ Sweep figures: for every panel, each output of :data:`plough.study.matrix.OUTPUT
 size (dims ``series, axis, h``), its extrapolation to h -> 0 (Richardson with the observed order and
 Roache's GCI, least-squares fallback flagged; :mod:`plough.study.extrapolation`) as
 ``<output>_h0``, ``<output>_h0_uncertainty``, ``<output>_h0_order``, ``<output>_h0_method``,
-``<output>_h0_flagged``, and the analytical model (eqs. 1-5) on the same coordinates as
-``<output>_analytical``. A figure with two panels suffixes its variables with the panel name
-(``dp_a``, ``dp_b``). Single-run figures keep the force histories, profiles and particle pictures
-of the finest run of each case, along a ``case`` dimension.
+``<output>_h0_flagged``, the runs' sampling errors (``<output>_standard_error`` per size) and
+their propagation to the limit (``<output>_h0_sampling_error``), and the analytical model (eqs.
+1-5) on the same coordinates as ``<output>_analytical``. A figure with two panels suffixes its
+variables with the panel name (``dp_a``, ``dp_b``). Single-run figures keep the force histories,
+profiles and particle pictures of the finest run of each case, along a ``case`` dimension.
 
 Coordinates are the config's values (never float arithmetic), so datasets align exactly.
 """
@@ -24,7 +25,7 @@ import xarray as xr
 from plough.io import provenance_attrs
 from plough.mpm.io import STANDARD_ERROR_META, STEADINESS_META, STEADY_META
 from plough.study import matrix
-from plough.study.extrapolation import extrapolate_dataarray
+from plough.study.extrapolation import extrapolate, extrapolate_dataarray, sampling_error
 from plough.study.skipping import is_skipped
 
 TITLES = {
@@ -125,6 +126,13 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
             if field == "order":
                 var.attrs["allow_missing"] = 1  # NaN: undefined order of an exactly converged point
             out[name] = var
+        se = errors.get(f"{o}_standard_error")
+        if se is not None and np.isfinite(se).any():
+            out[f"{o}_h0_sampling_error{suffix}"] = (
+                (panel.series_dim, panel.axis), _limit_sampling_error(sizes_um, values, se, skipped),
+                {"units": units, "allow_missing": 1,
+                 "long_name": f"standard error of {o} extrapolated to h -> 0 from the runs' sampling errors "
+                              "(at the extrapolation's order; missing where a run's error is)"})
     for o, values in analytical.items():
         units, long_name = STEADY_META[o]
         out[f"{o}_analytical{suffix}"] = ((panel.series_dim, panel.axis), values,
@@ -145,6 +153,18 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     out[f"skipped_finest{suffix}"] = ((panel.series_dim, panel.axis), skipped.astype(np.int8),
                                       {"units": "1", "long_name": "finest size skipped (mpm.skip_finest_tolerance): "
                                        "extrapolated from the two coarser sizes"})
+    return out
+
+
+def _limit_sampling_error(sizes_um: tuple[float, ...], values: np.ndarray, se: np.ndarray,
+                          skipped: np.ndarray) -> np.ndarray:
+    """The runs' sampling errors carried through the h -> 0 extrapolation (the two coarser sizes' where
+    the finest run was skipped)."""
+    h = np.asarray(sizes_um, dtype=float)
+    out = sampling_error(h, extrapolate(h, values), se)
+    if skipped.any():
+        coarse = sampling_error(h[-3:-1], extrapolate(h[-3:-1], values[..., -3:-1]), se[..., -3:-1])
+        out = np.where(skipped, coarse, out)
     return out
 
 
