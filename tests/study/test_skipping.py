@@ -74,3 +74,18 @@ def test_skippable_runs_are_finest_sweep_runs_never_pictures():
         assert (finest, coarse, mid) == (f"{stem}_h10", f"{stem}_h20", f"{stem}_h14")
     cfg["mpm"]["particle_sizes_um"] = [20, 10]
     assert matrix.skippable_runs(cfg) == {}  # two sizes: nothing left to extrapolate from
+
+
+def test_the_runs_sampling_errors_count_against_skipping():
+    """Two coarse runs that agree within the tolerance by their GCI but whose own noise is larger do not
+    let the finest run be skipped; the sampling error is 2 s_mid and s_coarse in quadrature (order 1, r = 2)."""
+    coarse, mid = _run(0.40, 5e-6), _run(0.41, 5e-6)
+    quiet = skipping.two_size_extrapolation(coarse, mid, 20.0, 10.0)
+    assert quiet["mu"]["sampling_error"] == 0.0 and skipping.should_skip(quiet, 0.08)  # 0.03 / 0.42
+    noisy_c = coarse.assign(mu_standard_error=0.01, dp_standard_error=0.0)
+    noisy_m = mid.assign(mu_standard_error=0.02, dp_standard_error=0.0)
+    noisy = skipping.two_size_extrapolation(noisy_c, noisy_m, 20.0, 10.0)
+    assert noisy["mu"]["sampling_error"] == pytest.approx(np.hypot(2 * 0.02, 0.01), rel=1e-12)
+    assert noisy["mu"]["uncertainty"] == pytest.approx(quiet["mu"]["uncertainty"], rel=1e-12)
+    assert noisy["mu"]["relative_uncertainty"] == pytest.approx(np.hypot(0.03, np.hypot(0.04, 0.01)) / 0.42, rel=1e-12)
+    assert not skipping.should_skip(noisy, 0.08)

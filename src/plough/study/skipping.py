@@ -4,7 +4,8 @@ The finest size costs about 8 x 2 = 16 times the next one (eight times the parti
 steps), so it dominates the full reproduction. With ``mpm.skip_finest_tolerance`` set, the run of
 a sweep point at the finest size first reads the point's two next-coarser runs and extrapolates
 them to h -> 0 (:func:`plough.study.extrapolation.extrapolate` with two sizes: Richardson with the
-assumed order 1 and Roache's safety factor 3). If that extrapolation's uncertainty is within the
+assumed order 1 and Roache's safety factor 3). If that extrapolation's uncertainty (the GCI and the
+two runs' sampling errors carried to the limit, in quadrature) is within the
 tolerance of its value for every steady-state output in :data:`CHECKED` the finest run is not
 made: its result file is a *skip marker* (no result variables; attributes say why, with the two
 extrapolations), and the figure dataset extrapolates that point from the two coarser sizes, flagged
@@ -24,7 +25,7 @@ import numpy as np
 import xarray as xr
 
 from plough.io import provenance_attrs
-from plough.study.extrapolation import extrapolate
+from plough.study.extrapolation import extrapolate, sampling_error
 
 #: Outputs whose two-size extrapolation must be within the tolerance to skip the finest run.
 CHECKED = ("mu", "dp")
@@ -33,13 +34,24 @@ SKIPPED_ATTR = "skipped_finest_size"
 
 def two_size_extrapolation(coarse: xr.Dataset, mid: xr.Dataset, h_coarse_um: float, h_mid_um: float,
                            outputs: tuple[str, ...] = CHECKED) -> dict[str, dict[str, float]]:
-    """output -> {value, uncertainty, relative_uncertainty} of the two-size extrapolation."""
+    """output -> {value, uncertainty, sampling_error, relative_uncertainty} of the two-size extrapolation.
+
+    ``uncertainty`` is the GCI (safety factor 3); ``sampling_error`` the two runs' own standard
+    errors (``<output>_standard_error``, 0 where a run has none: files from before they were written)
+    carried to the limit, 2 s_mid and s_coarse in quadrature at order 1 and r = 2. The relative
+    uncertainty that decides takes both in quadrature: two coarse runs whose noise alone exceeds
+    the tolerance do not stand in for the finest.
+    """
     out = {}
+    h = [h_coarse_um, h_mid_um]
     for o in outputs:
-        ex = extrapolate([h_coarse_um, h_mid_um], [float(coarse[o]), float(mid[o])])
+        ex = extrapolate(h, [float(coarse[o]), float(mid[o])])
+        se = [float(run[f"{o}_standard_error"]) if f"{o}_standard_error" in run else 0.0 for run in (coarse, mid)]
+        sampling = float(sampling_error(h, ex, se))
         value, unc = float(ex.value), float(ex.uncertainty)
-        rel = unc / abs(value) if value != 0 else (0.0 if unc == 0 else np.inf)
-        out[o] = {"value": value, "uncertainty": unc, "relative_uncertainty": rel}
+        total = float(np.hypot(unc, sampling))
+        rel = total / abs(value) if value != 0 else (0.0 if total == 0 else np.inf)
+        out[o] = {"value": value, "uncertainty": unc, "sampling_error": sampling, "relative_uncertainty": rel}
     return out
 
 
