@@ -25,8 +25,15 @@ def new_figure(nrows: int, ncols: int, width: float = 10.0, height_per_row: floa
     return fig, axes
 
 
+#: caption characters per inch of figure width at its 9.5 pt font (130 on the 10-inch two-panel figures)
+CAPTION_CHARS_PER_INCH = 13.0
+
+
 def caption(fig: Figure, text: str) -> None:
-    fig.suptitle("\n".join(textwrap.wrap(text, 130)), fontsize=9.5, ha="left", x=0.01)
+    """The figure's caption above the panels, wrapped to the figure's width (a fixed width cut the
+    captions of the 6.5-inch single-panel figures at the right edge)."""
+    width = int(CAPTION_CHARS_PER_INCH * fig.get_figwidth())
+    fig.suptitle("\n".join(textwrap.wrap(text, width)), fontsize=9.5, ha="left", x=0.01)
 
 
 def shade_where(ax, x, mask, label: str | None = None) -> None:
