@@ -46,7 +46,7 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")  # unsteady windows are reported in the row (mu_drift, steady)
             ds = simulate(scene, progress=False, threads=threads)
-        row = {q: float(ds[q]) for q in KEEP}
+        row = {q: float(ds[q]) if q in ds else float("nan") for q in KEEP}  # dp's error may be left out
         row.update(phase=k / phases, start_x_m=scene.start_x_m, wall_s=time.perf_counter() - t0,
                    particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]))
         runs.append(row)
@@ -59,8 +59,8 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
         se = np.array([r[f"{q}_standard_error"] for r in runs])
         summary[q] = {"mean": float(v.mean()), "std": float(v.std(ddof=1)),
                       "relative_std": float(v.std(ddof=1) / v.mean()), "min": float(v.min()), "max": float(v.max()),
-                      "median_standard_error": float(np.median(se)),
-                      "std_over_median_standard_error": float(v.std(ddof=1) / np.median(se))}
+                      "median_standard_error": float(np.nanmedian(se)),
+                      "std_over_median_standard_error": float(v.std(ddof=1) / np.nanmedian(se))}
     return {"scene": name, "h_um": h_um, "phases": phases, "runs": runs, "summary": summary}
 
 

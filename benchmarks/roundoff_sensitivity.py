@@ -6,7 +6,7 @@ Each case runs a scene with the workflow's numerics (graded particles, fine zone
 active zone of 4, sized block) at particle size h and at the next float64 below h
 (``numpy.nextafter``): a relative change of 1e-16 in h, dt and dx, far below any physical or
 numerical meaning. Runs are deterministic, so any difference between the two is how strongly the
-run amplifies round-off. Measured (2026-11-23): 1e-13 to 4e-12 relative in mu and dp, so round-off
+run amplifies round-off. Measured (2026-11-23): 4e-14 to 4e-12 relative in mu and dp, so round-off
 is not the noise of a run; the start against the particle lattice is (``lattice_phase.py``, README
 "Lattice phase"). A value of h at which some length is a whole number of particles (1e-5 m exactly)
 can flip a discrete tie instead: avoid such h here. Scenes: real =

@@ -23,7 +23,7 @@ from plough.figures import plot
 from plough.io import to_json, write_netcdf_atomic
 from plough.mpm.io import SERIES_META, STANDARD_ERROR_META, STEADY_META
 from plough.study import matrix
-from plough.study.extrapolation import Method
+from plough.study.extrapolation import Method, extrapolate
 from plough.study.mpm_figures import build_dataset
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -204,12 +204,17 @@ def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path)
                     se_value("mu", sig, h), rel=1e-12)
                 dp_se = float(ds["dp_standard_error"].sel(sel).sel(h=h))
                 assert np.isnan(dp_se) if noisy else dp_se == pytest.approx(se_value("dp", sig, h), rel=1e-12)
-            # the runs' errors carried to the limit: Richardson at the observed order, f0 = (1 + g) f1 - g f2
-            h1, h2 = sorted(SIZES)[:2]
-            if not noisy:
-                g = 1.0 / ((h2 / h1) ** float(ds["mu_h0_order"].sel(sel)) - 1.0)
-                expected = np.hypot((1 + g) * se_value("mu", sig, h1), g * se_value("mu", sig, h2))
-                assert float(ds["mu_h0_sampling_error"].sel(sel)) == pytest.approx(expected, rel=1e-9)
+            # the runs' errors carried to the limit: d mu_h0 / d mu(h) by differencing extrapolate() on the
+            # dataset's own per-size values, times each run's error
+            hs = ds["h"].values
+            mu_h = ds["mu"].sel(sel).values
+            jac = []
+            for k in range(hs.size):
+                d = np.zeros(hs.size)
+                d[k] = 1e-7
+                jac.append((float(extrapolate(hs, mu_h + d).value) - float(extrapolate(hs, mu_h - d).value)) / 2e-7)
+            expected = np.sqrt(np.sum((np.array(jac) * [se_value("mu", sig, h) for h in hs]) ** 2))
+            assert float(ds["mu_h0_sampling_error"].sel(sel)) == pytest.approx(expected, rel=1e-5)
             assert bool(np.isnan(float(ds["dp_h0_sampling_error"].sel(sel)))) == noisy  # a run's dp error missing
             expected = matrix.analytical_values(matrix.real_point(real, label, load, r1))
             for o, v in expected.items():

@@ -89,3 +89,14 @@ def test_the_runs_sampling_errors_count_against_skipping():
     assert noisy["mu"]["uncertainty"] == pytest.approx(quiet["mu"]["uncertainty"], rel=1e-12)
     assert noisy["mu"]["relative_uncertainty"] == pytest.approx(np.hypot(0.03, np.hypot(0.04, 0.01)) / 0.42, rel=1e-12)
     assert not skipping.should_skip(noisy, 0.08)
+
+
+def test_a_newer_run_without_its_dp_error_never_skips():
+    """A run that writes the errors but could not estimate dp's (fewer than 2 sections) does not count as
+    noiseless: the finest run is made. Files from before the errors (none of them) count as 0."""
+    coarse, mid = _run(0.40, 5e-6), _run(0.41, 5e-6)
+    assert skipping.should_skip(skipping.two_size_extrapolation(coarse, mid, 20.0, 10.0), 0.5)
+    newer = mid.assign(mu_standard_error=0.0)  # no dp_standard_error
+    ex = skipping.two_size_extrapolation(coarse, newer, 20.0, 10.0)
+    assert np.isnan(ex["dp"]["sampling_error"]) and ex["mu"]["sampling_error"] == 0.0
+    assert not skipping.should_skip(ex, 0.5)

@@ -98,7 +98,8 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
 
 def _scene_note(ds: xr.Dataset) -> str:
     return f"Particle sizes h = {', '.join(f'{h:g}' for h in ds['h'].values)} µm; marks: extrapolated to h -> 0 " \
-           "(Richardson; bars: Roache GCI and the runs' sampling errors carried to the limit, in quadrature; " \
+           "(Richardson; bars: Roache GCI and the runs' sampling errors carried to the limit, in quadrature, " \
+           "the GCI alone where a run's error is missing; " \
            "hollow = fallback, flagged), faint: per size with the run's sampling standard error; " \
            "lines: analytical model."
 

@@ -19,6 +19,7 @@ from __future__ import annotations
 import base64
 import json
 import warnings
+from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -67,11 +68,11 @@ STEADY_META = {
 #: contiguous batches the steady window's records and the residual sections are cut into for the jackknife
 SE_BATCHES = 10
 STANDARD_ERROR_META = {
-    f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over {SE_BATCHES} contiguous "
-                                    "batches of the steady window's records)")
+    f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over up to {SE_BATCHES} "
+                                    "contiguous batches of the steady window's records)")
     for name in ("mu", "mu_pl", "mu_sh")
-} | {"dp_standard_error": ("m", f"sampling standard error of dp (jackknife over {SE_BATCHES} contiguous batches "
-                                "of the residual sections)")}
+} | {"dp_standard_error": ("m", f"sampling standard error of dp (jackknife over up to {SE_BATCHES} contiguous "
+                                "batches of the residual sections)")}
 
 #: a window is steady when mu moves by at most this fraction between its halves ...
 STEADY_MU_DRIFT = 0.05
@@ -211,15 +212,18 @@ def groove_depths(y: np.ndarray, z_top: np.ndarray, contact_radius: float) -> tu
     return float(max(-np.nanmin(z_top[near_track]), 0.0)), float(max(np.nanmax(z_top), 0.0))
 
 
-def jackknife_standard_error(statistic, n: int, batches: int = SE_BATCHES) -> float | None:
+def jackknife_standard_error(statistic: Callable[[np.ndarray], float], n: int,
+                             batches: int = SE_BATCHES) -> float | None:
     """Delete-one-batch jackknife standard error of ``statistic(kept indices)`` over ``n`` ordered samples.
 
     The samples (records of the steady window, or residual sections) are cut into ``min(batches, n)``
     contiguous batches; each batch is left out in turn. Contiguous batches, not single samples,
     because neighbouring records are correlated (the force saw-tooths with the prow); the
     jackknife, not the spread of batch values, because mu is a ratio of means and dp the extreme
-    of a mean profile: nonlinear statistics of the samples. None when fewer than 2 batches or when a
-    leave-one-out value is not finite (a subset without normal force or without a profile).
+    of a mean profile: nonlinear statistics of the samples. With fewer samples than batches each
+    sample is a batch and the correlation argument no longer holds (a short window, a coarse run).
+    None when fewer than 2 batches or when a leave-one-out value is not finite (a subset without
+    normal force or without a profile).
     """
     k = min(batches, n)
     if k < 2:

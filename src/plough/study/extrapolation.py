@@ -279,28 +279,58 @@ def extrapolate(
     )
 
 
-def sampling_error(h: ArrayLike, ex: Extrapolation, standard_error: ArrayLike) -> NDArray[np.float64]:
-    """Standard error of ``ex.value`` from independent standard errors of the per-size values.
+def sampling_error(h: ArrayLike, f: ArrayLike, standard_error: ArrayLike) -> NDArray[np.float64]:
+    """Standard error of the extrapolated value ``extrapolate(h, f).value`` from independent standard
+    errors of the per-size values, by linear propagation: ``sqrt(sum (d f0 / d f_i)^2 s_i^2)``.
 
-    Every method writes the extrapolated value as a weighted sum of the per-size values once its
-    order is fixed: Richardson and two sizes ``(1 + g) f1 - g f2`` with ``g = 1 / (r^p - 1)``, the
-    least-squares fit the regression's intercept weights, converged ``f1``. The error is
-    ``sqrt(sum (w_i s_i)^2)``; the scatter the values' noise puts into the observed order itself is
-    not included. ``standard_error`` is ordered like ``h`` and shaped like the ``f`` given to
-    :func:`extrapolate`; NaN where a needed size's error is missing, or the point is missing.
+    The derivatives, per method:
+
+    * Richardson: ``f0 = f1 + e21 g(p)`` with ``g = 1 / (r^p - 1)`` and the observed order ``p``,
+      which is itself a function of the three finest values (``ln(e21 / e32) = phi(p)``, see
+      :func:`_log_ratio_model`), so ``d f0 = d f1 + g d e21 + e21 g'(p) d p`` with
+      ``d p = d ln(e21 / e32) / phi'(p)``. At order 1 and r = 2 the weights are (4, -4, 1): the
+      noise of the finest value enters four times over.
+    * two sizes (assumed order): ``(1 + g) f1 - g f2``;
+    * least squares (assumed order): the regression intercept's weights;
+    * converged: ``f1``.
+
+    ``standard_error`` has the shape of ``f`` with its sizes ordered like ``h``. NaN where a needed
+    size's error is missing (an unused size's may be), or where the point is missing.
     """
     h = _validate_sizes(h)
+    f = np.asarray(f, dtype=float)
     se = np.asarray(standard_error, dtype=float)
-    if se.ndim == 0 or se.shape[-1] != h.size or se.shape[:-1] != ex.value.shape:
-        raise ValueError(f"standard_error (shape {se.shape}) must have the shape of f: {ex.value.shape} + ({h.size},)")
-    hs = h[np.argsort(h)]
-    se = se[..., np.argsort(h)].reshape(-1, h.size)
+    if se.shape != f.shape or f.ndim == 0 or f.shape[-1] != h.size:
+        raise ValueError(f"standard_error (shape {se.shape}) must have the shape of f ({f.shape}), "
+                         f"whose last axis matches h ({h.size} sizes)")
+    ex = extrapolate(h, f)
+    sort = np.argsort(h)
+    hs = h[sort]
+    fs = f[..., sort].reshape(-1, h.size)
+    se = se[..., sort].reshape(-1, h.size)
     method, order = ex.method.reshape(-1), ex.order.reshape(-1)
     weights = np.zeros_like(se)
     weights[:, 0] = 1.0  # converged: the finest value
-    fixed = (method == Method.RICHARDSON) | (method == Method.TWO_SIZES_ASSUMED_ORDER)
-    g = 1.0 / ((hs[1] / hs[0]) ** order[fixed] - 1.0)
-    weights[fixed, 0], weights[fixed, 1] = 1.0 + g, -g
+    r21 = hs[1] / hs[0]
+    two = method == Method.TWO_SIZES_ASSUMED_ORDER
+    g = 1.0 / (r21 ** order[two] - 1.0)
+    weights[two, 0], weights[two, 1] = 1.0 + g, -g
+    rich = np.flatnonzero(method == Method.RICHARDSON)
+    if rich.size:
+        p = order[rich]
+        a, b = np.log(hs[1] / hs[0]), np.log(hs[2] / hs[1])
+        e21 = fs[rich, 0] - fs[rich, 1]
+        e32 = fs[rich, 1] - fs[rich, 2]
+        g = 1.0 / np.expm1(p * a)
+        dg_dp = -a * np.exp(p * a) * g**2
+        dphi_dp = a / np.expm1(p * a) - b * np.exp(p * b) / np.expm1(p * b)
+        d_e21 = np.array([1.0, -1.0, 0.0])
+        d_e32 = np.array([0.0, 1.0, -1.0])
+        d_logratio = d_e21[None, :] / e21[:, None] - d_e32[None, :] / e32[:, None]
+        dp = d_logratio / dphi_dp[:, None]
+        jac = np.array([1.0, 0.0, 0.0])[None, :] + g[:, None] * d_e21[None, :] + (e21 * dg_dp)[:, None] * dp
+        weights[rich, 0] = 0.0
+        weights[rich, :3] = jac
     for row in np.flatnonzero(method == Method.LEAST_SQUARES):
         x = hs ** order[row]
         weights[row] = 1.0 / h.size - x.mean() * (x - x.mean()) / np.sum((x - x.mean()) ** 2)

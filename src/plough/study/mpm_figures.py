@@ -25,7 +25,7 @@ import xarray as xr
 from plough.io import provenance_attrs
 from plough.mpm.io import STANDARD_ERROR_META, STEADINESS_META, STEADY_META
 from plough.study import matrix
-from plough.study.extrapolation import extrapolate, extrapolate_dataarray, sampling_error
+from plough.study.extrapolation import extrapolate_dataarray, sampling_error
 from plough.study.skipping import is_skipped
 
 TITLES = {
@@ -132,7 +132,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                 (panel.series_dim, panel.axis), _limit_sampling_error(sizes_um, values, se, skipped),
                 {"units": units, "allow_missing": 1,
                  "long_name": f"standard error of {o} extrapolated to h -> 0 from the runs' sampling errors "
-                              "(at the extrapolation's order; missing where a run's error is)"})
+                              "(linear propagation; missing where a needed run's error is)"})
     for o, values in analytical.items():
         units, long_name = STEADY_META[o]
         out[f"{o}_analytical{suffix}"] = ((panel.series_dim, panel.axis), values,
@@ -161,9 +161,9 @@ def _limit_sampling_error(sizes_um: tuple[float, ...], values: np.ndarray, se: n
     """The runs' sampling errors carried through the h -> 0 extrapolation (the two coarser sizes' where
     the finest run was skipped)."""
     h = np.asarray(sizes_um, dtype=float)
-    out = sampling_error(h, extrapolate(h, values), se)
+    out = sampling_error(h, values, se)
     if skipped.any():
-        coarse = sampling_error(h[-3:-1], extrapolate(h[-3:-1], values[..., -3:-1]), se[..., -3:-1])
+        coarse = sampling_error(h[-3:-1], values[..., -3:-1], se[..., -3:-1])
         out = np.where(skipped, coarse, out)
     return out
 

@@ -25,6 +25,7 @@ import numpy as np
 import xarray as xr
 
 from plough.io import provenance_attrs
+from plough.mpm.io import STANDARD_ERROR_META
 from plough.study.extrapolation import extrapolate, sampling_error
 
 #: Outputs whose two-size extrapolation must be within the tolerance to skip the finest run.
@@ -37,22 +38,32 @@ def two_size_extrapolation(coarse: xr.Dataset, mid: xr.Dataset, h_coarse_um: flo
     """output -> {value, uncertainty, sampling_error, relative_uncertainty} of the two-size extrapolation.
 
     ``uncertainty`` is the GCI (safety factor 3); ``sampling_error`` the two runs' own standard
-    errors (``<output>_standard_error``, 0 where a run has none: files from before they were written)
-    carried to the limit, 2 s_mid and s_coarse in quadrature at order 1 and r = 2. The relative
-    uncertainty that decides takes both in quadrature: two coarse runs whose noise alone exceeds
-    the tolerance do not stand in for the finest.
+    errors (``<output>_standard_error``; 0 for files from before they were written, NaN, so no skip,
+    where a newer run could not estimate it) carried to the limit, 2 s_mid and s_coarse in
+    quadrature at order 1 and r = 2. The relative uncertainty that decides takes both in
+    quadrature: two coarse runs whose noise alone exceeds the tolerance do not stand in for the
+    finest.
     """
     out = {}
     h = [h_coarse_um, h_mid_um]
     for o in outputs:
-        ex = extrapolate(h, [float(coarse[o]), float(mid[o])])
-        se = [float(run[f"{o}_standard_error"]) if f"{o}_standard_error" in run else 0.0 for run in (coarse, mid)]
-        sampling = float(sampling_error(h, ex, se))
+        f = [float(coarse[o]), float(mid[o])]
+        ex = extrapolate(h, f)
+        sampling = float(sampling_error(h, f, [_run_error(run, o) for run in (coarse, mid)]))
         value, unc = float(ex.value), float(ex.uncertainty)
         total = float(np.hypot(unc, sampling))
         rel = total / abs(value) if value != 0 else (0.0 if total == 0 else np.inf)
         out[o] = {"value": value, "uncertainty": unc, "sampling_error": sampling, "relative_uncertainty": rel}
     return out
+
+
+def _run_error(run: xr.Dataset, output: str) -> float:
+    """A run's sampling error of ``output``: 0 for a file from before the errors were written (none of
+    them), NaN where this one could not be estimated (then the finest run is never skipped)."""
+    name = f"{output}_standard_error"
+    if name in run:
+        return float(run[name])
+    return 0.0 if not any(n in run for n in STANDARD_ERROR_META) else float("nan")
 
 
 def should_skip(extrapolations: dict[str, dict[str, float]], tolerance: float) -> bool:
