@@ -484,6 +484,9 @@ def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_fil
         assert int(ds[f"{o}_h0_method"].sel(sel)) == Method.TWO_SIZES_ASSUMED_ORDER
         assert int(ds[f"{o}_h0_flagged"].sel(sel)) == 1
         assert np.isnan(float(ds[o].sel(sel).sel(h=min(SIZES))))
+        if o in ("mu", "dp"):  # the runs' errors through the two-size extrapolation: (1 + g) s2, g s3
+            expected = np.hypot((1 + gain) * se_value(o, sig, h2), gain * se_value(o, sig, h3))
+            assert float(ds[f"{o}_h0_sampling_error"].sel(sel)) == pytest.approx(expected, rel=1e-12), o
         _check_extrapolation(ds, o, {"material": "zinc_block", "load_N": loads[1]},
                              signature(loads[1], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer"))
     assert int(ds["skipped_finest"].sum()) == 1 and int(ds["skipped_finest"].sel(sel)) == 1
