@@ -242,9 +242,10 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
     """Sampling standard errors of the steady-state results (``STANDARD_ERROR_META``).
 
     The steady window is a finite sample of a fluctuating force and the residual groove a finite
-    number of sections: these errors say how far the same run with a different but equally long
-    sample (a perturbation at round-off level) would likely move mu and dp. dp's error is omitted
-    when fewer than 2 sections were measured.
+    number of sections: these errors estimate how far the same run with a different but equally
+    long sample (the sphere started elsewhere against the particle lattice) would move mu and dp;
+    measured against such runs they are order-of-magnitude bars (README "Lattice phase"). dp's
+    error is omitted when fewer than 2 sections were measured.
     """
     idx = np.flatnonzero(mask)
     fx, fz = series["Fx"][idx], series["Fz"][idx]
