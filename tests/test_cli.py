@@ -66,3 +66,53 @@ def test_mpm_preset_reaches_the_solver(monkeypatch, tmp_path, capsys):
     scene.write_text(scene.read_text().replace("f: 1.0", "f: 0.5"))
     assert main(["mpm", str(scene), "-o", str(out), "--quiet"]) == 2
     assert "note:" not in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("extra, message", [
+    (["--interface", "constant", "--f", "0.5"], "--f = 0.5 applies to --interface proportional, not to --interface "
+                                                "constant (its options: --H0-MPa)"),
+    (["--np", "-1"], "--np = -1 applies to --interface boundary_layer, not to --interface proportional"),
+    (["--interface", "boundary_layer", "--np", "-1"], "np = -1 is outside the allowed range [0, 1]"),
+    (["--f", "1.5"], "f = 1.5 is outside the allowed range [0, 1]"),
+])
+def test_analytical_interface_options_are_checked_or_refused(extra, message, capsys):
+    assert main(ARGS + extra) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err
+
+
+def test_analytical_interface_defaults_apply_to_the_chosen_model(capsys):
+    def mu(extra):
+        assert main(ARGS + extra) == 0
+        out = capsys.readouterr().out
+        return float(next(s for s in out.splitlines() if s.split()[0] == "mu").split()[1])
+
+    assert mu([]) == mu(["--f", "1"])
+    assert mu(["--interface", "constant"]) == mu(["--interface", "constant", "--H0-MPa", "450"])
+    bl = ["--interface", "boundary_layer"]
+    assert mu(bl) == mu(bl + ["--Cp", "0.32", "--np", "0.95"])
+    assert mu(["--f", "0.5"]) < mu([])
+
+
+@pytest.mark.parametrize("scene_text, message", [
+    ("name: x\nsphere: {radius_um: 200\n", "not valid YAML at line"),
+    (None, "is a directory"),
+])
+def test_mpm_unreadable_scene_is_one_line_and_exit_2(scene_text, message, tmp_path, capsys):
+    scene = tmp_path
+    if scene_text is not None:
+        scene = tmp_path / "scene.yaml"
+        scene.write_text(scene_text)
+    assert main(["mpm", str(scene), "-o", str(tmp_path / "r.nc"), "--quiet"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err
+
+
+def test_mpm_bad_thread_count_names_the_option(tmp_path, capsys):
+    from pathlib import Path
+
+    scene = Path(__file__).resolve().parents[1] / "examples" / "stability_small.yaml"
+    assert main(["mpm", str(scene), "-o", str(tmp_path / "r.nc"), "--quiet", "--threads", "0"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and "threads = 0 is outside the allowed range 1.." in err
+    assert not (tmp_path / "r.nc").exists()

@@ -43,22 +43,47 @@ def _add_analytical(sub: argparse._SubParsersAction) -> None:
                    choices=["proportional", "constant", "boundary_layer"],
                    help="interface shear model: proportional tau = f H/k0, constant tau = H0/k0, "
                    "boundary_layer tau = Cp P^np (default proportional)")
-    p.add_argument("--f", type=float, default=1.0,
+    p.add_argument("--f", type=float, default=None,
                    help="interface factor f in [0, 1] of the proportional model (default 1)")
-    p.add_argument("--H0-MPa", type=float, default=450.0,
+    p.add_argument("--H0-MPa", type=float, default=None,
                    help="hardness H0 in MPa of the constant model, tau = H0/k0 (default 450)")
-    p.add_argument("--Cp", type=float, default=0.32,
+    p.add_argument("--Cp", type=float, default=None,
                    help="boundary-layer coefficient Cp (tau and P in Pa, default 0.32)")
-    p.add_argument("--np", dest="np_exponent", type=float, default=0.95,
+    p.add_argument("--np", dest="np_exponent", type=float, default=None,
                    help="boundary-layer exponent np in [0, 1] (default 0.95)")
     p.add_argument("--correction", default="none", choices=["none", "once", "converged"],
                    help="normal-load correction of eq. 5 (default none)")
     p.set_defaults(func=_run_analytical)
 
 
+#: interface model -> {its CLI options (dest): default}; an option of another model is refused
+_INTERFACE_OPTIONS = {"proportional": {"f": 1.0}, "constant": {"H0_MPa": 450.0},
+                      "boundary_layer": {"Cp": 0.32, "np_exponent": 0.95}}
+_OPTION_FLAGS = {"f": "--f", "H0_MPa": "--H0-MPa", "Cp": "--Cp", "np_exponent": "--np"}
+
+
+def _interface_options(args: argparse.Namespace) -> None:
+    """Fill the chosen interface model's defaults; refuse options that only another model reads."""
+    own = _INTERFACE_OPTIONS[args.interface]
+    for model, options in _INTERFACE_OPTIONS.items():
+        for dest in options:
+            if model != args.interface and getattr(args, dest) is not None:
+                raise ValueError(f"{_OPTION_FLAGS[dest]} = {getattr(args, dest):g} applies to --interface {model}, "
+                                 f"not to --interface {args.interface} (its options: "
+                                 f"{', '.join(_OPTION_FLAGS[d] for d in own)})")
+    for dest, default in own.items():
+        if getattr(args, dest) is None:
+            setattr(args, dest, default)
+    for model, options in _INTERFACE_OPTIONS.items():
+        for dest, default in options.items():
+            if model != args.interface:
+                setattr(args, dest, default)  # unused by the model; the function still takes a value
+
+
 def _run_analytical(args: argparse.Namespace) -> int:
     from plough.analytical import RESULT_META, ploughing
 
+    _interface_options(args)
     res = ploughing(
         load_N=args.load_N, radius_m=args.radius_mm * 1e-3, thickness_m=args.thickness_um * 1e-6,
         coating_hardness_Pa=args.coating_hardness_MPa * 1e6,

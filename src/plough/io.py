@@ -74,6 +74,22 @@ def check_finite(ds: xr.Dataset, name: str = "dataset") -> None:
                 raise ValueError(f"{name}: variable {var_name!r} holds non-finite values; not written")
 
 
+def _umask() -> int:
+    mask = os.umask(0)  # reading the umask means setting it: put it straight back
+    os.umask(mask)
+    return mask
+
+
+def publish(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
+    """Rename a finished temporary file onto ``path`` with the mode a plain ``open`` would give it.
+
+    ``tempfile.mkstemp`` creates files readable by their owner only (0600); results on a shared
+    machine must be readable as the user's umask allows (0644 under the usual 022).
+    """
+    os.chmod(tmp, 0o666 & ~_umask())
+    os.replace(tmp, path)
+
+
 def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
     """Write ``ds`` to ``path`` through a temporary file and an atomic rename."""
     path = Path(path)
@@ -83,7 +99,7 @@ def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
     os.close(fd)
     try:
         ds.to_netcdf(tmp, engine="netcdf4")
-        os.replace(tmp, path)
+        publish(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

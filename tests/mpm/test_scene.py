@@ -154,6 +154,30 @@ BAD = {
                                  r"discretisation\.active_zone_contact_radii"),
     "rigid-plastic extra key": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": 900, "foo": 1}),
                                 r"layers\.substrate.*foo"),
+    # an integer field holding inf / NaN, text in a unit-suffixed key, a bool as a number
+    "particles_per_cell inf": (_mutate(discretisation__particles_per_cell=float("inf")),
+                               r"discretisation\.particles_per_cell = inf is not an integer"),
+    "records nan": (_mutate(outputs__records=float("nan")), r"outputs\.records = nan is not an integer"),
+    "text in a _um key": (_mutate(sphere__radius_um="abc"), r"sphere\.radius_um = 'abc' is not a number"),
+    "text in a layers _um key": (_mutate(layers__coating_thickness_um="thick"),
+                                 r"layers\.coating_thickness_um = 'thick' is not a number"),
+    "text in a material _MPa key": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": "soft"}),
+                                    r"layers\.substrate\.rigid_plastic_hardness_MPa = 'soft' is not a number"),
+    "load true": (_mutate(load_N=True), r"load_N = True is not a number"),
+    "initial temperature nan": (_mutate(outputs__initial_temperature_K=float("nan")),
+                                r"outputs\.initial_temperature_K = nan K is outside the allowed range \(0, 2000\]"),
+    "initial temperature negative": (_mutate(outputs__initial_temperature_K=-500),
+                                     r"outputs\.initial_temperature_K = -500"),
+    "a name with a path": (_mutate(name="../../escape/x"), r"name = '\.\./\.\./escape/x' is not allowed"),
+    "a name with a space": (_mutate(name="my run"), r"name = 'my run' is not allowed"),
+    "material dict missing keys": (_mutate(layers__substrate={"hardness_MPa": 450}),
+                                   r"layers\.substrate: not a material: missing key\(s\).*unknown key\(s\)"),
+    "material flow key unknown": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": "constant",
+                                                                                        "sigma_y": 1e8}}),
+                                  r"layers\.substrate\.flow \(constant\): missing key\(s\) \['sigma_y_Pa'\]"),
+    "material flow text": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": "constant",
+                                                                                 "sigma_y_Pa": "hard"}}),
+                           r"layers\.substrate\.flow\.sigma_y_Pa = 'hard' is not a number"),
 }
 
 
@@ -183,6 +207,53 @@ def test_bad_input_in_constructors():
 def test_unknown_or_missing_interface_key_is_a_value_error(interface):
     with pytest.raises(ValueError, match="interface"):
         Scene.from_dict(_mutate(interface=interface))
+
+
+def test_a_coating_without_its_thickness_is_refused_not_dropped():
+    d = example_dict("coated_rigid_plastic")
+    del d["layers"]["coating_thickness_um"]
+    with pytest.raises(ValueError, match=r"layers\.coating_thickness_um is missing although layers\.coating"):
+        Scene.from_dict(d)
+    d["layers"]["coating_thickness_um"] = 0  # said so: an uncoated scene
+    assert not Scene.from_dict(d).layers.coated
+
+
+def test_exponents_without_a_decimal_point_are_numbers_everywhere_in_a_scene_file():
+    """YAML 1.1 reads 5e-1 as text; the scene loader reads it as the number a user means, in every part."""
+    text = (EXAMPLES[0].parent / "coated_rigid_plastic.yaml").read_text()
+    d = yaml.safe_load(text)
+    d["interface"] = {"model": "proportional", "f": "5e-1"}
+    d["layers"]["coating"] = {**ZINC_COATING.to_dict(), "youngs_modulus_Pa": "90e9"}
+    from_text = Scene.from_yaml(yaml.safe_dump(d).replace("'5e-1'", "5e-1").replace("'90e9'", "90e9"))
+    from_dict = Scene.from_dict(d)  # the strings themselves (a dict from another YAML reader)
+    for s in (from_text, from_dict):
+        assert s.interface == ProportionalShear(f=0.5)
+        assert s.layers.coating.youngs_modulus_Pa == 90e9
+    flow = {"model": "constant", "sigma_y_MPa": "150e0"}
+    s = Scene.from_dict(_mutate(layers__substrate={**DX56.to_dict(), "flow": flow}))
+    assert s.layers.substrate.flow.sigma_y_Pa == 150e6  # _MPa converted inside the flow mapping too
+
+
+def test_scene_file_errors_are_one_line_value_errors(tmp_path):
+    broken = tmp_path / "broken.yaml"
+    broken.write_text("name: x\nsphere: {radius_um: 200\nload_N: 3\n")
+    with pytest.raises(ValueError, match=r"broken\.yaml: not valid YAML at line \d+, column \d+"):
+        Scene.from_yaml(broken)
+    with pytest.raises(ValueError, match="is a directory"):
+        Scene.from_yaml(tmp_path)
+
+
+def test_a_scene_too_large_for_the_memory_is_refused_before_allocating():
+    s = Scene.from_yaml(EXAMPLES[0].parent / "uncoated_rigid_plastic.yaml")
+    solver.check_memory(s, available_bytes=10**12)  # the example fits in 1 TB
+    small = replace(s, discretisation=replace(s.discretisation, particle_size_m=0.1e-6))
+    with pytest.raises(ValueError, match=r"discretisation\.particle_size_m = 1e-07 m gives at least .* particles"):
+        solver.check_memory(small, available_bytes=10**12)
+    graded = replace(small, discretisation=replace(small.discretisation, graded=True))
+    n = 0.25 * math.pi * s.domain.radius_m**2 * s.domain.length_m / 1e-21
+    solver.check_memory(graded, available_bytes=int(n / 8 * solver.STATE_BYTES_PER_PARTICLE) + 1)  # the lower bound
+    with pytest.raises(ValueError, match="GiB"):
+        solver.check_memory(graded, available_bytes=int(n / 8 * solver.STATE_BYTES_PER_PARTICLE) - 1)
 
 
 def test_part_that_is_not_a_mapping_is_a_value_error():

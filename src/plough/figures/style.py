@@ -13,6 +13,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
+from plough.io import publish  # noqa: E402
+
 COLOURS = {"mu": "k", "mu_pl": "tab:blue", "mu_sh": "tab:orange", "soft": "tab:blue", "hard": "tab:red",
            "none": "k", "once": "tab:green", "converged": "tab:purple"}
 LABELS = {"mu": r"$\mu$", "mu_pl": r"$\mu_{pl}$", "mu_sh": r"$\mu_{sh}$"}
@@ -51,7 +53,7 @@ def save(fig: Figure, outputs: list[str | os.PathLike[str]]) -> None:
         os.close(fd)
         try:
             fig.savefig(tmp, dpi=150)
-            os.replace(tmp, out)
+            publish(tmp, out)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
             raise

@@ -111,10 +111,19 @@ class SteadyStateWarning(UserWarning):
     """The run's steady window does not hold a steady state (``io.steadiness``)."""
 
 
+def check_threads(threads: int) -> None:
+    """Refuse a thread count numba cannot use, naming it (numba's own error names no parameter)."""
+    most = numba.config.NUMBA_NUM_THREADS
+    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= most:
+        raise ValueError(f"threads = {threads!r} is outside the allowed range 1..{most} (this machine's cores, or "
+                         "NUMBA_NUM_THREADS)")
+
+
 def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path | None = None,
              threads: int | None = None) -> xr.Dataset:
     """Run the MPM ploughing simulation of ``scene`` and return its results dataset."""
     if threads is not None:
+        check_threads(threads)
         numba.set_num_threads(threads)
     wall0 = time.perf_counter()
     state, const = solver.init(scene)
@@ -213,6 +222,8 @@ def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir:
                    on_scene: Callable[[Scene], None] | None = None) -> Path:
     """Read a scene YAML, apply the optional preset, simulate, write the netCDF atomically
     (nothing is written on failure). ``on_scene`` sees the validated scene before the run."""
+    if threads is not None:
+        check_threads(threads)
     scene = apply_preset(Scene.from_yaml(Path(scene_path)), preset)
     if on_scene is not None:
         on_scene(scene)

@@ -13,6 +13,7 @@ so a scene file may say ``radius_um: 200`` for the field ``radius_m``.
 from __future__ import annotations
 
 import math
+import re
 from dataclasses import asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
@@ -20,6 +21,8 @@ from typing import Any
 import yaml
 
 from plough.materials import (
+    FLOW_MODELS,
+    INTERFACES,
     ROOM_TEMPERATURE_K,
     BoundaryLayerShear,
     ConstantFlow,
@@ -49,15 +52,41 @@ CFL_MAX = 0.6
 INERTIA_MAX = 4.0
 
 
-def _to_si(d: dict[str, Any]) -> dict[str, Any]:
+#: A scene's name becomes part of file names (snapshots): letters, digits and ``._+-=`` only, no path.
+_NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._+=-]*")
+
+
+class _SceneLoader(yaml.SafeLoader):
+    """YAML 1.1 reads 5e-1 and 150e6 (no decimal point) as text; a scene file means numbers (YAML 1.2)."""
+
+
+_SceneLoader.add_implicit_resolver(
+    "tag:yaml.org,2002:float",
+    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
+    list("-+0123456789."),
+)
+
+
+def _number(value: Any, where: str) -> float:
+    """``value`` as a float, or a one-line error naming ``where`` (true / false are not numbers)."""
+    if isinstance(value, bool):
+        raise ValueError(f"{where} = {value!r} is not a number")
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        raise ValueError(f"{where} = {value!r} is not a number") from None
+
+
+def _to_si(d: dict[str, Any], where: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
+    prefix = f"{where}." if where else ""
     for key, value in d.items():
         for suffix, (si_suffix, factor) in _UNIT_SUFFIXES.items():
-            if key.endswith(suffix):
+            if isinstance(key, str) and key.endswith(suffix):
                 new = key[: -len(suffix)] + si_suffix
                 if new in d:
                     raise ValueError(f"both {key!r} and {new!r} given; give one")
-                out[new] = None if value is None else float(value) * factor
+                out[new] = None if value is None else _number(value, f"{prefix}{key}") * factor
                 break
         else:
             out[key] = value
@@ -68,12 +97,9 @@ def _coerce(value: Any, type_name: str, where: str) -> Any:
     """YAML 1.1 reads 1.0e6 as a string: convert numbers by the field's declared type."""
     if value is None or type_name not in ("float", "int", "float | None"):
         return value
-    try:
-        number = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{where} = {value!r} is not a number") from None
+    number = _number(value, where)
     if type_name == "int":
-        if number != int(number):
+        if not math.isfinite(number) or number != int(number):
             raise ValueError(f"{where} = {value!r} is not an integer")
         return int(number)
     return number
@@ -88,7 +114,7 @@ def _mapping(d: Any, where: str) -> dict[str, Any]:
 
 
 def _from_dict(cls: type, d: dict[str, Any] | None, where: str) -> Any:
-    d = _to_si(_mapping(d, where))
+    d = _to_si(_mapping(d, where), where)
     types = {f.name: str(f.type) for f in fields(cls)}
     unknown = set(d) - set(types)
     if unknown:
@@ -315,6 +341,12 @@ class Discretisation:
         return self.particle_size_m * self.particles_per_cell
 
 
+#: Highest initial temperature accepted, K: above the melting point of every metal of the materials
+#: data (zinc 693 K, steel about 1800 K) the flow laws mean nothing; the check catches typos (in degC
+#: or negative) rather than setting a physical bound per material.
+INITIAL_TEMPERATURE_MAX_K = 2000.0
+
+
 @dataclass(frozen=True)
 class Outputs:
     """What a run records. ``steady_window`` is the fraction of the slide averaged for the
@@ -345,6 +377,10 @@ class Outputs:
             raise ValueError(f"outputs.buried_profile_depth_m = {self.buried_profile_depth_m!r} m must be > 0")
         if not (0 <= self.taylor_quinney <= 1):
             raise ValueError(f"outputs.taylor_quinney = {self.taylor_quinney!r} is outside [0, 1]")
+        T = self.initial_temperature_K
+        if not (isinstance(T, int | float) and math.isfinite(T) and 0 < T <= INITIAL_TEMPERATURE_MAX_K):
+            raise ValueError(f"outputs.initial_temperature_K = {T!r} K is outside the allowed range "
+                             f"(0, {INITIAL_TEMPERATURE_MAX_K:g}] K")
 
 
 # ----------------------------------------------------------------------------- materials in files
@@ -358,7 +394,7 @@ def material_from_spec(spec: Any, *, coating: bool, where: str) -> Material:
         except ValueError as exc:
             raise ValueError(f"{where}: {exc}") from None
     if isinstance(spec, dict):
-        d = _to_si(spec)
+        d = _to_si(spec, where)
         if "rigid_plastic_hardness_Pa" in d:
             extra = set(d) - {"rigid_plastic_hardness_Pa", "name"}
             if extra:
@@ -366,11 +402,45 @@ def material_from_spec(spec: Any, *, coating: bool, where: str) -> Material:
             H = d["rigid_plastic_hardness_Pa"]
             name = d.get("name", f"rigid_plastic_H{H / 1e6:g}MPa")
             return rigid_plastic(name, H, coating=coating)
-        try:
-            return Material.from_dict(d)
-        except (TypeError, KeyError) as exc:
-            raise ValueError(f"{where}: not a material ({exc})") from None
+        return Material.from_dict(_material_numbers(d, where))
     raise ValueError(f"{where} = {spec!r} is not a material name, a rigid-plastic hardness or a material dict")
+
+
+def _material_numbers(d: dict[str, Any], where: str) -> dict[str, Any]:
+    """A material dict with its keys checked and its numbers converted (``_MPa`` etc. in the flow
+    mapping too), so that ``Material.from_dict`` sees only what it can build."""
+    allowed = {f.name: str(f.type) for f in fields(Material)}
+    missing = sorted(set(allowed) - set(d))
+    unknown = sorted(set(d) - set(allowed))
+    if missing or unknown:
+        raise ValueError(f"{where}: not a material: " + "; ".join(
+            ([f"missing key(s) {missing}"] if missing else []) + ([f"unknown key(s) {unknown}"] if unknown else []))
+            + f" (a material needs {sorted(allowed)}, or is a name of the materials data, or "
+            "{rigid_plastic_hardness_MPa: H})")
+    out = {k: _coerce(v, allowed[k], f"{where}.{k}") for k, v in d.items() if k != "flow"}
+    flow = _to_si(_mapping(d["flow"], f"{where}.flow"), f"{where}.flow")
+    model = flow.get("model")
+    if model not in FLOW_MODELS:
+        raise ValueError(f"{where}.flow.model = {model!r} is not one of {list(FLOW_MODELS)}")
+    types = {f.name: str(f.type) for f in fields(FLOW_MODELS[model])}
+    unknown = sorted(set(flow) - set(types) - {"model"})
+    missing = sorted(set(types) - set(flow))
+    if missing or unknown:
+        raise ValueError(f"{where}.flow ({model}): " + "; ".join(
+            ([f"missing key(s) {missing}"] if missing else []) + ([f"unknown key(s) {unknown}"] if unknown else []))
+            + f"; allowed: {sorted(types)}")
+    out["flow"] = {"model": model} | {k: _coerce(v, types[k], f"{where}.flow.{k}") for k, v in flow.items()
+                                      if k != "model"}
+    return out
+
+
+def _interface_numbers(d: dict[str, Any]) -> dict[str, Any]:
+    """The interface dict with its numbers converted by the model's field types (YAML 1.1 reads 5e-1 as text)."""
+    cls = INTERFACES.get(d.get("model"))
+    if cls is None:
+        return d
+    types = {f.name: str(f.type) for f in fields(cls)}
+    return {k: _coerce(v, types[k], f"interface.{k}") if k in types else v for k, v in d.items()}
 
 
 # ----------------------------------------------------------------------------- the scene
@@ -389,6 +459,11 @@ class Scene:
     name: str = "scene"
 
     def __post_init__(self) -> None:
+        if not (isinstance(self.name, str) and _NAME_PATTERN.fullmatch(self.name)):
+            raise ValueError(f"name = {self.name!r} is not allowed: it names the run's files, so it must be letters, "
+                             "digits and . _ + - = only, starting with a letter, digit or _ (no path, no spaces)")
+        if isinstance(self.load_N, bool):
+            raise ValueError(f"load_N = {self.load_N!r} is not a number")
         _finite_positive("scene", "load_N", self.load_N, "N")
         if not isinstance(self.interface, ProportionalShear | ConstantShear | BoundaryLayerShear):
             raise ValueError(f"interface = {self.interface!r} is not an interface model")
@@ -550,14 +625,17 @@ class Scene:
             raise ValueError(f"scene: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
         if "layers" not in d:
             raise ValueError("scene: the key 'layers' (substrate, coating, coating_thickness) is required")
-        lay = _to_si(_mapping(d["layers"], "layers"))
+        lay = _to_si(_mapping(d["layers"], "layers"), "layers")
         unknown = set(lay) - {"substrate", "coating", "coating_thickness_m"}
         if unknown:
             raise ValueError(f"layers: unknown key(s) {sorted(unknown)}")
         if "substrate" not in lay:
             raise ValueError("layers.substrate is required")
-        t = _coerce(lay.get("coating_thickness_m", 0.0) or 0.0, "float", "layers.coating_thickness_m")
         coating_spec = lay.get("coating")
+        if coating_spec is not None and lay.get("coating_thickness_m") is None:
+            raise ValueError("layers.coating_thickness_um is missing although layers.coating is given: give the "
+                             "thickness (0 for an uncoated scene) or leave the coating out")
+        t = _coerce(lay.get("coating_thickness_m", 0.0) or 0.0, "float", "layers.coating_thickness_m")
         layers = Layers(
             substrate=material_from_spec(lay["substrate"], coating=False, where="layers.substrate"),
             coating=None if coating_spec is None else material_from_spec(coating_spec, coating=True,
@@ -570,7 +648,8 @@ class Scene:
         if "load_N" in d:
             kwargs["load_N"] = _coerce(d["load_N"], "float", "load_N")
         if "interface" in d:
-            kwargs["interface"] = interface_from_dict(_to_si(_mapping(d["interface"], "interface")))
+            kwargs["interface"] = interface_from_dict(_interface_numbers(_to_si(_mapping(d["interface"], "interface"),
+                                                                                "interface")))
         for key, cls_ in (("sphere", Sphere), ("domain", Domain), ("sliding", Sliding),
                           ("discretisation", Discretisation), ("outputs", Outputs)):
             if key in d:
@@ -595,10 +674,20 @@ class Scene:
         if isinstance(path_or_text, Path) or (isinstance(path_or_text, str) and "\n" not in path_or_text):
             if not p.exists():
                 raise FileNotFoundError(f"scene file {str(p)!r} does not exist")
+            if p.is_dir():
+                raise ValueError(f"scene file {str(p)!r} is a directory, not a YAML file")
             text = p.read_text()
+            source = str(p)
         else:
             text = str(path_or_text)
-        data = yaml.safe_load(text)
+            source = "scene text"
+        try:
+            data = yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
+        except yaml.YAMLError as exc:
+            where = getattr(exc, "problem_mark", None)
+            at = f" at line {where.line + 1}, column {where.column + 1}" if where is not None else ""
+            problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+            raise ValueError(f"{source}: not valid YAML{at}: {problem}") from None
         if not isinstance(data, dict):
             raise ValueError("a scene file must hold a mapping of keys to values")
         return cls.from_dict(data)

@@ -25,6 +25,7 @@ index ranges; the material beyond is frozen and clamps the active part.
 from __future__ import annotations
 
 import math
+import os
 from dataclasses import dataclass, field
 
 import numba
@@ -180,8 +181,42 @@ def interface_arrays(scene: Scene) -> tuple[int, np.ndarray]:
     raise ValueError(f"interface = {itf!r} is unknown")
 
 
+#: bytes of one particle's state (position, velocity, affine matrix, stress and the scalars, float64)
+#: without the grid or any scratch: a lower bound, so that only a run that cannot fit is refused
+STATE_BYTES_PER_PARTICLE = 250
+
+
+def physical_memory_bytes() -> int | None:
+    """This machine's physical memory, or None where the OS does not say."""
+    try:
+        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
+def check_memory(scene: Scene, available_bytes: int | None = None) -> None:
+    """Refuse, before allocating anything, a scene whose particles alone exceed the physical memory.
+
+    The count is the block's volume over h^3 (an eighth of it for graded particles: every far-field
+    group of 8 may become one), a lower bound of what ``seed_particles`` makes.
+    """
+    available = physical_memory_bytes() if available_bytes is None else available_bytes
+    if available is None:
+        return
+    dom, h = scene.domain, scene.discretisation.particle_size_m
+    cross = (0.25 if dom.symmetric else 0.5) * math.pi * dom.radius_m**2
+    particles = cross * dom.length_m / h**3 / (8.0 if scene.discretisation.graded else 1.0)
+    need = particles * STATE_BYTES_PER_PARTICLE
+    if need > available:
+        raise ValueError(f"discretisation.particle_size_m = {h:g} m gives at least {particles:.3g} particles in the "
+                         f"{dom.length_m:g} m x {dom.radius_m:g} m block, at least {need / 2**30:.3g} GiB, more than "
+                         f"this machine's {available / 2**30:.3g} GiB of memory (coarser particles or a smaller "
+                         "domain)")
+
+
 def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     """The initial state (undeformed block, sphere touching the surface) and the run constants."""
+    check_memory(scene)
     mats = scene.layers.materials
     table = pack_materials(mats)
     rows = {"substrate": len(mats) - 1}
