@@ -196,7 +196,10 @@ def test_normal_load_correction():
         (dict(k1=0.0), r"k1 = 0 "),
         (dict(f=1.5), r"f = 1.5 is outside the allowed range \[0, 1\]"),
         (dict(f=-0.1), r"f = -0.1 is outside"),
-        (dict(load_N=1e4), r"load_N = 10000 N is too large .* dp < r"),
+        (dict(load_N=1e4), r"load_N = 10000 N is too large for radius_m = 0.0002 m: the model .* dp < r"),
+        (dict(interface="constant", H0_Pa=1e10, correction="converged"),
+         r"load_N = 3 N is too large for radius_m = 0.0002 m once the normal-load correction .* 'converged'\) has "
+         r"raised the carried load to [0-9.e+]+ N"),
         (dict(interface="sticky"), r"interface = 'sticky' is unknown; allowed: proportional"),
         (dict(correction="twice"), r"correction = 'twice' is unknown"),
         (dict(load_N=np.array([1.0, np.nan])), r"load_N = nan N"),

@@ -245,9 +245,14 @@ def ploughing(
         geo = _contact_geometry(carried, r, t, Hcs, Hs)
         if np.any(geo["too_wide"]):
             i = np.flatnonzero(np.ravel(geo["too_wide"]))[0]
+            given, held = float(np.ravel(load)[i]), float(np.ravel(carried)[i])
+            raised = "" if held == given else (
+                f" once the normal-load correction (eq. 5, correction = {correction!r}) has raised the carried "
+                f"load to {held:.4g} N by the interface shear's vertical part (a smaller interface shear, or "
+                "correction = 'none')")
             raise ValueError(
-                f"load_N = {float(np.ravel(load)[i]):g} N is too large for radius_m = "
-                f"{float(np.ravel(r)[i]):g} m: the model has no contact with the ploughing depth "
+                f"load_N = {given:g} N is too large for radius_m = "
+                f"{float(np.ravel(r)[i]):g} m{raised}: the model has no contact with the ploughing depth "
                 f"below the sphere's equator (allowed: dp < r, contact radius a < r)"
             )
         tau_c, tau_s = _interface_shear(interface, Hc, Hs, fa, H0, Cpa, npa, carried, geo["Axy"])
