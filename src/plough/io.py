@@ -10,8 +10,8 @@ from __future__ import annotations
 
 import json
 import os
+import secrets
 import subprocess
-import tempfile
 from functools import lru_cache
 from pathlib import Path
 from typing import Any
@@ -74,20 +74,22 @@ def check_finite(ds: xr.Dataset, name: str = "dataset") -> None:
                 raise ValueError(f"{name}: variable {var_name!r} holds non-finite values; not written")
 
 
-def _umask() -> int:
-    mask = os.umask(0)  # reading the umask means setting it: put it straight back
-    os.umask(mask)
-    return mask
+def temporary_beside(path: str | os.PathLike[str], suffix: str = ".part") -> Path:
+    """Create an empty hidden file next to ``path`` for an atomic write, and return its name.
 
-
-def publish(tmp: str | os.PathLike[str], path: str | os.PathLike[str]) -> None:
-    """Rename a finished temporary file onto ``path`` with the mode a plain ``open`` would give it.
-
-    ``tempfile.mkstemp`` creates files readable by their owner only (0600); results on a shared
-    machine must be readable as the user's umask allows (0644 under the usual 022).
+    Made with ``os.open(..., 0o666)``, so the kernel applies the user's umask: the renamed result
+    is as readable as a plain ``open`` would make it (``tempfile.mkstemp`` makes 0600 files, and
+    reading the umask from Python means setting it, a race with other threads).
     """
-    os.chmod(tmp, 0o666 & ~_umask())
-    os.replace(tmp, path)
+    path = Path(path)
+    for _ in range(100):
+        tmp = path.parent / f".{path.name}.{secrets.token_hex(6)}{suffix}"
+        try:
+            os.close(os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666))
+        except FileExistsError:
+            continue
+        return tmp
+    raise FileExistsError(f"no free temporary name next to {str(path)!r}")
 
 
 def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
@@ -95,11 +97,10 @@ def write_netcdf_atomic(ds: xr.Dataset, path: str | os.PathLike[str]) -> Path:
     path = Path(path)
     check_finite(ds, str(path))
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".part", dir=path.parent)
-    os.close(fd)
+    tmp = temporary_beside(path)
     try:
         ds.to_netcdf(tmp, engine="netcdf4")
-        publish(tmp, path)
+        os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise

@@ -271,7 +271,8 @@ def interface_from_dict(d: dict[str, Any]) -> Interface:
     allowed = {f.name for f in fields(cls)}
     unknown = set(d) - allowed
     if unknown:
-        raise ValueError(f"interface: unknown key(s) {sorted(unknown)} for model {model!r}; allowed: {sorted(allowed)}")
+        raise ValueError(f"interface: unknown key(s) {sorted(map(str, unknown))} for model {model!r}; "
+                         f"allowed: {sorted(allowed)}")
     try:
         return cls(**d)
     except TypeError as exc:

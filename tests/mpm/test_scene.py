@@ -175,6 +175,17 @@ BAD = {
     "material flow key unknown": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": "constant",
                                                                                         "sigma_y": 1e8}}),
                                   r"layers\.substrate\.flow \(constant\): missing key\(s\) \['sigma_y_Pa'\]"),
+    "flow model a list": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": ["constant"]}}),
+                          r"layers\.substrate\.flow\.model = \['constant'\] is not one of"),
+    "interface model a list": (_mutate(interface={"model": ["proportional"]}),
+                               r"interface\.model = \['proportional'\]"),
+    "material keys of mixed types": (_mutate(layers__substrate={1: 2, "foo": 3}),
+                                     r"layers\.substrate: not a material: missing key\(s\).*"
+                                     r"unknown key\(s\) \['1', 'foo'\]"),
+    "rigid-plastic hardness null": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": None}),
+                                    r"layers\.substrate\.rigid_plastic_hardness_Pa = None is not a number"),
+    "rigid-plastic SI hardness text": (_mutate(layers__substrate={"rigid_plastic_hardness_Pa": "hard"}),
+                                       r"layers\.substrate\.rigid_plastic_hardness_Pa = 'hard' is not a number"),
     "material flow text": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": "constant",
                                                                                  "sigma_y_Pa": "hard"}}),
                            r"layers\.substrate\.flow\.sigma_y_Pa = 'hard' is not a number"),
@@ -212,7 +223,8 @@ def test_unknown_or_missing_interface_key_is_a_value_error(interface):
 def test_a_coating_without_its_thickness_is_refused_not_dropped():
     d = example_dict("coated_rigid_plastic")
     del d["layers"]["coating_thickness_um"]
-    with pytest.raises(ValueError, match=r"layers\.coating_thickness_um is missing although layers\.coating"):
+    with pytest.raises(ValueError, match=r"layers\.coating_thickness \(_um, _mm or _m\) is missing or null although "
+                                         r"layers\.coating"):
         Scene.from_dict(d)
     d["layers"]["coating_thickness_um"] = 0  # said so: an uncoated scene
     assert not Scene.from_dict(d).layers.coated
@@ -232,6 +244,19 @@ def test_exponents_without_a_decimal_point_are_numbers_everywhere_in_a_scene_fil
     flow = {"model": "constant", "sigma_y_MPa": "150e0"}
     s = Scene.from_dict(_mutate(layers__substrate={**DX56.to_dict(), "flow": flow}))
     assert s.layers.substrate.flow.sigma_y_Pa == 150e6  # _MPa converted inside the flow mapping too
+    s = Scene.from_yaml(text.replace("coating: {rigid_plastic_hardness_MPa: 450}",
+                                     "coating: {rigid_plastic_hardness_Pa: 45e7}"))
+    assert s.layers.coating.flow.sigma_y_Pa == pytest.approx(150e6)  # H / 3, from a key in SI
+
+
+@pytest.mark.parametrize("name", ["1e5", "5e-1", "2E3", "10"])
+def test_names_that_look_like_numbers_stay_names_through_a_round_trip(name):
+    s = replace(Scene.from_yaml(EXAMPLES[0].parent / "coated_rigid_plastic.yaml"), name=name)
+    back = Scene.from_yaml(s.to_yaml())
+    assert back == s and back.name == name
+    coat = rigid_plastic(name, 450e6, coating=True)
+    s = replace(s, layers=replace(s.layers, coating=coat))
+    assert Scene.from_yaml(s.to_yaml()).layers.coating.name == name
 
 
 def test_scene_file_errors_are_one_line_value_errors(tmp_path):

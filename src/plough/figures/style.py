@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import tempfile
 import textwrap
 from pathlib import Path
 
@@ -13,7 +12,7 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
-from plough.io import publish  # noqa: E402
+from plough.io import temporary_beside  # noqa: E402
 
 COLOURS = {"mu": "k", "mu_pl": "tab:blue", "mu_sh": "tab:orange", "soft": "tab:blue", "hard": "tab:red",
            "none": "k", "once": "tab:green", "converged": "tab:purple"}
@@ -49,11 +48,10 @@ def save(fig: Figure, outputs: list[str | os.PathLike[str]]) -> None:
     for out in outputs:
         out = Path(out)
         out.parent.mkdir(parents=True, exist_ok=True)
-        fd, tmp = tempfile.mkstemp(prefix=f".{out.stem}.", suffix=out.suffix, dir=out.parent)
-        os.close(fd)
+        tmp = temporary_beside(out, suffix=out.suffix)  # the suffix tells savefig the format
         try:
             fig.savefig(tmp, dpi=150)
-            publish(tmp, out)
+            os.replace(tmp, out)
         except BaseException:
             Path(tmp).unlink(missing_ok=True)
             raise

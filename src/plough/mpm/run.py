@@ -6,6 +6,7 @@
 
 from __future__ import annotations
 
+import numbers
 import time
 import warnings
 from collections.abc import Callable
@@ -114,7 +115,7 @@ class SteadyStateWarning(UserWarning):
 def check_threads(threads: int) -> None:
     """Refuse a thread count numba cannot use, naming it (numba's own error names no parameter)."""
     most = numba.config.NUMBA_NUM_THREADS
-    if isinstance(threads, bool) or not isinstance(threads, int) or not 1 <= threads <= most:
+    if isinstance(threads, bool) or not isinstance(threads, numbers.Integral) or not 1 <= threads <= most:
         raise ValueError(f"threads = {threads!r} is outside the allowed range 1..{most} (this machine's cores, or "
                          "NUMBA_NUM_THREADS)")
 

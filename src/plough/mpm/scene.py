@@ -56,17 +56,6 @@ INERTIA_MAX = 4.0
 _NAME_PATTERN = re.compile(r"[A-Za-z0-9_][A-Za-z0-9._+=-]*")
 
 
-class _SceneLoader(yaml.SafeLoader):
-    """YAML 1.1 reads 5e-1 and 150e6 (no decimal point) as text; a scene file means numbers (YAML 1.2)."""
-
-
-_SceneLoader.add_implicit_resolver(
-    "tag:yaml.org,2002:float",
-    re.compile(r"^[-+]?(?:[0-9][0-9_]*(?:\.[0-9_]*)?|\.[0-9_]+)[eE][-+]?[0-9]+$"),
-    list("-+0123456789."),
-)
-
-
 def _number(value: Any, where: str) -> float:
     """``value`` as a float, or a one-line error naming ``where`` (true / false are not numbers)."""
     if isinstance(value, bool):
@@ -118,7 +107,7 @@ def _from_dict(cls: type, d: dict[str, Any] | None, where: str) -> Any:
     types = {f.name: str(f.type) for f in fields(cls)}
     unknown = set(d) - set(types)
     if unknown:
-        raise ValueError(f"{where}: unknown key(s) {sorted(unknown)}; allowed: {sorted(types)}")
+        raise ValueError(f"{where}: unknown key(s) {sorted(map(str, unknown))}; allowed: {sorted(types)}")
     return cls(**{k: _coerce(v, types[k], f"{where}.{k}") for k, v in d.items()})
 
 
@@ -378,7 +367,8 @@ class Outputs:
         if not (0 <= self.taylor_quinney <= 1):
             raise ValueError(f"outputs.taylor_quinney = {self.taylor_quinney!r} is outside [0, 1]")
         T = self.initial_temperature_K
-        if not (isinstance(T, int | float) and math.isfinite(T) and 0 < T <= INITIAL_TEMPERATURE_MAX_K):
+        if isinstance(T, bool) or not (isinstance(T, int | float) and math.isfinite(T)
+                                       and 0 < T <= INITIAL_TEMPERATURE_MAX_K):
             raise ValueError(f"outputs.initial_temperature_K = {T!r} K is outside the allowed range "
                              f"(0, {INITIAL_TEMPERATURE_MAX_K:g}] K")
 
@@ -398,9 +388,9 @@ def material_from_spec(spec: Any, *, coating: bool, where: str) -> Material:
         if "rigid_plastic_hardness_Pa" in d:
             extra = set(d) - {"rigid_plastic_hardness_Pa", "name"}
             if extra:
-                raise ValueError(f"{where}: unknown key(s) {sorted(extra)} for a rigid-plastic material")
-            H = d["rigid_plastic_hardness_Pa"]
-            name = d.get("name", f"rigid_plastic_H{H / 1e6:g}MPa")
+                raise ValueError(f"{where}: unknown key(s) {sorted(map(str, extra))} for a rigid-plastic material")
+            H = _number(d["rigid_plastic_hardness_Pa"], f"{where}.rigid_plastic_hardness_Pa")
+            name = str(d.get("name", f"rigid_plastic_H{H / 1e6:g}MPa"))
             return rigid_plastic(name, H, coating=coating)
         return Material.from_dict(_material_numbers(d, where))
     raise ValueError(f"{where} = {spec!r} is not a material name, a rigid-plastic hardness or a material dict")
@@ -411,7 +401,7 @@ def _material_numbers(d: dict[str, Any], where: str) -> dict[str, Any]:
     mapping too), so that ``Material.from_dict`` sees only what it can build."""
     allowed = {f.name: str(f.type) for f in fields(Material)}
     missing = sorted(set(allowed) - set(d))
-    unknown = sorted(set(d) - set(allowed))
+    unknown = sorted(map(str, set(d) - set(allowed)))
     if missing or unknown:
         raise ValueError(f"{where}: not a material: " + "; ".join(
             ([f"missing key(s) {missing}"] if missing else []) + ([f"unknown key(s) {unknown}"] if unknown else []))
@@ -420,10 +410,10 @@ def _material_numbers(d: dict[str, Any], where: str) -> dict[str, Any]:
     out = {k: _coerce(v, allowed[k], f"{where}.{k}") for k, v in d.items() if k != "flow"}
     flow = _to_si(_mapping(d["flow"], f"{where}.flow"), f"{where}.flow")
     model = flow.get("model")
-    if model not in FLOW_MODELS:
+    if not isinstance(model, str) or model not in FLOW_MODELS:
         raise ValueError(f"{where}.flow.model = {model!r} is not one of {list(FLOW_MODELS)}")
     types = {f.name: str(f.type) for f in fields(FLOW_MODELS[model])}
-    unknown = sorted(set(flow) - set(types) - {"model"})
+    unknown = sorted(map(str, set(flow) - set(types) - {"model"}))
     missing = sorted(set(types) - set(flow))
     if missing or unknown:
         raise ValueError(f"{where}.flow ({model}): " + "; ".join(
@@ -436,9 +426,10 @@ def _material_numbers(d: dict[str, Any], where: str) -> dict[str, Any]:
 
 def _interface_numbers(d: dict[str, Any]) -> dict[str, Any]:
     """The interface dict with its numbers converted by the model's field types (YAML 1.1 reads 5e-1 as text)."""
-    cls = INTERFACES.get(d.get("model"))
-    if cls is None:
-        return d
+    model = d.get("model")
+    if not isinstance(model, str) or model not in INTERFACES:
+        raise ValueError(f"interface.model = {model!r} is not one of {list(INTERFACES)}")
+    cls = INTERFACES[model]
     types = {f.name: str(f.type) for f in fields(cls)}
     return {k: _coerce(v, types[k], f"interface.{k}") if k in types else v for k, v in d.items()}
 
@@ -622,19 +613,19 @@ class Scene:
         allowed = {f.name for f in fields(cls)}
         unknown = set(d) - allowed
         if unknown:
-            raise ValueError(f"scene: unknown key(s) {sorted(unknown)}; allowed: {sorted(allowed)}")
+            raise ValueError(f"scene: unknown key(s) {sorted(map(str, unknown))}; allowed: {sorted(allowed)}")
         if "layers" not in d:
             raise ValueError("scene: the key 'layers' (substrate, coating, coating_thickness) is required")
         lay = _to_si(_mapping(d["layers"], "layers"), "layers")
         unknown = set(lay) - {"substrate", "coating", "coating_thickness_m"}
         if unknown:
-            raise ValueError(f"layers: unknown key(s) {sorted(unknown)}")
+            raise ValueError(f"layers: unknown key(s) {sorted(map(str, unknown))}")
         if "substrate" not in lay:
             raise ValueError("layers.substrate is required")
         coating_spec = lay.get("coating")
         if coating_spec is not None and lay.get("coating_thickness_m") is None:
-            raise ValueError("layers.coating_thickness_um is missing although layers.coating is given: give the "
-                             "thickness (0 for an uncoated scene) or leave the coating out")
+            raise ValueError("layers.coating_thickness (_um, _mm or _m) is missing or null although layers.coating "
+                             "is given: give the thickness (0 for an uncoated scene) or leave the coating out")
         t = _coerce(lay.get("coating_thickness_m", 0.0) or 0.0, "float", "layers.coating_thickness_m")
         layers = Layers(
             substrate=material_from_spec(lay["substrate"], coating=False, where="layers.substrate"),
@@ -682,7 +673,7 @@ class Scene:
             text = str(path_or_text)
             source = "scene text"
         try:
-            data = yaml.load(text, Loader=_SceneLoader)  # noqa: S506 - a SafeLoader subclass
+            data = yaml.safe_load(text)  # YAML 1.1: 5e-1 is text; the parts convert numbers by their field types
         except yaml.YAMLError as exc:
             where = getattr(exc, "problem_mark", None)
             at = f" at line {where.line + 1}, column {where.column + 1}" if where is not None else ""
