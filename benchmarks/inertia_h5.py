@@ -1,10 +1,13 @@
 """Inertia check of issue 3 at h = 5 um: the reference scene (sized block) with mass scaling / 2
 and with sliding speed / 2, / 4, / 8 against the defaults.
 
-    python benchmarks/inertia_h5.py [--only NAME ...]
+    python benchmarks/inertia_h5.py [--only NAME ...] [--f 0.5 --out benchmarks/results/inertia_h5_f0.5.json]
 
-Writes benchmarks/results/inertia_h5.json, keeping the cases already there (a case is run only when
-it is missing or named in --only). Speed / k is the inertia number ms rho v^2 / H / k^2 at k times
+Writes benchmarks/results/inertia_h5.json (or --out), keeping the cases already there (a case is run
+only when it is missing or named in --only). ``--f`` replaces the scene's interface factor (the
+example's f = 1 makes the interface as strong as the substrate, ``Scene.interface_sticks``); the
+case ``h10`` is the same scene at h = 10 um, for the discretisation change it is compared with.
+Speed / k is the inertia number ms rho v^2 / H / k^2 at k times
 the steps (mass scaling / k^2 gives the same numbers, benchmarks/timestep_check.py).
 """
 
@@ -17,6 +20,7 @@ from pathlib import Path
 
 import numba
 
+from plough.materials import ProportionalShear
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
@@ -26,15 +30,23 @@ ROOT = Path(__file__).resolve().parents[1]
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--only", nargs="*", default=None, help="(re)run only these cases")
+    parser.add_argument("--f", type=float, default=None, help="interface factor f (default: the example's)")
+    parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "inertia_h5.json")
     args = parser.parse_args()
     numba.set_num_threads(2)
-    base = Scene.from_yaml(ROOT / "examples" / "uncoated_rigid_plastic.yaml")
-    base = replace(base, discretisation=replace(base.discretisation, particle_size_m=5e-6)).with_sized_domain()
-    cases = {"baseline": base,
+    example = Scene.from_yaml(ROOT / "examples" / "uncoated_rigid_plastic.yaml")
+    if args.f is not None:
+        example = replace(example, interface=ProportionalShear(f=args.f))
+
+    def at_size(h_m: float) -> Scene:
+        return replace(example, discretisation=replace(example.discretisation, particle_size_m=h_m)).with_sized_domain()
+
+    base = at_size(5e-6)
+    cases = {"baseline": base, "h10": at_size(10e-6),
              "mass_scaling/2": replace(base, discretisation=replace(base.discretisation, mass_scaling=5e5))}
     for k in (2, 4, 8):
         cases[f"speed/{k}"] = replace(base, sliding=replace(base.sliding, speed_m_s=0.1 / k))
-    out = ROOT / "benchmarks" / "results" / "inertia_h5.json"
+    out = args.out
     rows = json.loads(out.read_text()) if out.exists() else {}
     for name, s in cases.items():
         if (args.only is None and name in rows) or (args.only is not None and name not in args.only):
