@@ -63,21 +63,17 @@ _OPTION_FLAGS = {"f": "--f", "H0_MPa": "--H0-MPa", "Cp": "--Cp", "np_exponent": 
 
 
 def _interface_options(args: argparse.Namespace) -> None:
-    """Fill the chosen interface model's defaults; refuse options that only another model reads."""
-    own = _INTERFACE_OPTIONS[args.interface]
-    for model, options in _INTERFACE_OPTIONS.items():
-        for dest in options:
-            if model != args.interface and getattr(args, dest) is not None:
-                raise ValueError(f"{_OPTION_FLAGS[dest]} = {getattr(args, dest):g} applies to --interface {model}, "
-                                 f"not to --interface {args.interface} (its options: "
-                                 f"{', '.join(_OPTION_FLAGS[d] for d in own)})")
-    for dest, default in own.items():
-        if getattr(args, dest) is None:
-            setattr(args, dest, default)
+    """Refuse options that only another interface model reads; fill every unset option with its
+    default (the function takes all four; the model reads its own)."""
+    own = ", ".join(_OPTION_FLAGS[d] for d in _INTERFACE_OPTIONS[args.interface])
     for model, options in _INTERFACE_OPTIONS.items():
         for dest, default in options.items():
-            if model != args.interface:
-                setattr(args, dest, default)  # unused by the model; the function still takes a value
+            given = getattr(args, dest)
+            if given is not None and model != args.interface:
+                raise ValueError(f"{_OPTION_FLAGS[dest]} = {given:g} applies to --interface {model}, not to "
+                                 f"--interface {args.interface} (its options: {own})")
+            if given is None:
+                setattr(args, dest, default)
 
 
 def _run_analytical(args: argparse.Namespace) -> int:
