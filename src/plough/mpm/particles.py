@@ -17,6 +17,7 @@ particle's edge is ``cbrt(vol0)``; nothing downstream assumes h.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -124,6 +125,14 @@ def _fine_half_width(scene: Scene) -> float:
     a, _ = scene.expected_contact()
     h = scene.discretisation.particle_size_m
     return max(scene.discretisation.fine_zone_contact_radii * a, FINE_ZONE_MIN_PARTICLES * h)
+
+
+def uniform_particle_count(scene: Scene) -> float:
+    """Particles of the uniform h lattice filling the block: its volume (a quarter cylinder with the
+    mirror plane, half without) over h^3, within a fraction of a per cent of what is seeded."""
+    dom, h = scene.domain, scene.discretisation.particle_size_m
+    cross = (0.25 if dom.symmetric else 0.5) * math.pi * dom.radius_m**2
+    return cross * dom.length_m / h**3
 
 
 def particle_count_ratio(scene: Scene) -> float:

@@ -39,7 +39,7 @@ from plough.materials import (
 from plough.mpm import contact, transfers
 from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
 from plough.mpm.grid import Grid, boundary_flags, make_grid, mirror_plane_index
-from plough.mpm.particles import Particles, seed_particles
+from plough.mpm.particles import Particles, seed_particles, uniform_particle_count
 from plough.mpm.scene import Scene
 
 # Load controller (see control_sphere): force filter, loop time constant and integral time in
@@ -204,8 +204,7 @@ def check_memory(scene: Scene, available_bytes: int | None = None) -> None:
     if available is None:
         return
     dom, h = scene.domain, scene.discretisation.particle_size_m
-    cross = (0.25 if dom.symmetric else 0.5) * math.pi * dom.radius_m**2
-    particles = cross * dom.length_m / h**3 / (8.0 if scene.discretisation.graded else 1.0)
+    particles = uniform_particle_count(scene) / (8.0 if scene.discretisation.graded else 1.0)
     need = particles * STATE_BYTES_PER_PARTICLE
     if need > available:
         raise ValueError(f"discretisation.particle_size_m = {h:g} m gives at least {particles:.3g} particles in the "

@@ -17,7 +17,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from plough.mpm.particles import particle_count_ratio
+from plough.mpm.particles import particle_count_ratio, uniform_particle_count
 from plough.mpm.scene import Scene
 
 #: Bytes per particle (state arrays) plus the grid share at 2 particles per cell and 2 threads,
@@ -56,10 +56,8 @@ def wave_speed_m_s(scene: Scene) -> float:
 
 def estimate(scene: Scene) -> RunCost:
     """Particles and steps of a run of ``scene`` (within a few per cent of the solver's)."""
-    h = scene.discretisation.particle_size_m
     dom = scene.domain
-    cross = (0.25 if dom.symmetric else 0.5) * math.pi * dom.radius_m**2  # quarter / half disc below z = 0
-    particles = int(cross * dom.length_m / h**3 * particle_count_ratio(scene))
+    particles = int(uniform_particle_count(scene) * particle_count_ratio(scene))
     v = scene.sliding.speed_m_s
     dt = scene.discretisation.cfl * scene.discretisation.cell_size_m / (wave_speed_m_s(scene) + 2 * v)
     _, dp = scene.expected_contact()

@@ -329,7 +329,6 @@ def sampling_error(h: ArrayLike, f: ArrayLike, standard_error: ArrayLike) -> NDA
         d_logratio = d_e21[None, :] / e21[:, None] - d_e32[None, :] / e32[:, None]
         dp = d_logratio / dphi_dp[:, None]
         jac = np.array([1.0, 0.0, 0.0])[None, :] + g[:, None] * d_e21[None, :] + (e21 * dg_dp)[:, None] * dp
-        weights[rich, 0] = 0.0
         weights[rich, :3] = jac
     for row in np.flatnonzero(method == Method.LEAST_SQUARES):
         x = hs ** order[row]
