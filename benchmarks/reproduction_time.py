@@ -20,6 +20,10 @@ Runs whose layers use the real materials' flow laws (hardening, rate terms, heat
 go at the real-materials' share of the constant-flow throughput measured on the same block
 (benchmarks/results/material_cost.json, ``benchmarks/material_cost.py``); the rigid-plastic runs
 at the reference throughput.
+Last, the floor no code can beat on this machine: the particle-steps of the matrix (all, and with
+every skippable finest run skipped) at the memory-bandwidth bound of a step (bytes a particle-step
+moves, from a kernel profile, over the triad bandwidth: benchmarks/kernel_profile.py), and the
+throughput each would need to finish within the issue's 4 hours.
 Writes benchmarks/results/reproduction_time.json and prints a Markdown table.
 """
 
@@ -74,6 +78,10 @@ def main() -> None:
     parser.add_argument("--graded-measured", default=str(ROOT / "benchmarks" / "results" / "graded_particles.json"))
     parser.add_argument("--zone-measured", default=str(ROOT / "benchmarks" / "results" / "active_zone.json"))
     parser.add_argument("--material-measured", default=str(ROOT / "benchmarks" / "results" / "material_cost.json"))
+    parser.add_argument("--bandwidth-measured",
+                        default=str(ROOT / "benchmarks" / "results" / "kernel_profile_zinc_coated_steel_h10.json"),
+                        help="kernel profile whose bytes per particle-step and triad bandwidth give the bound")
+    parser.add_argument("--target-h", type=float, default=4.0, help="wall-time target of the full reproduction, h")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
     args = parser.parse_args()
     config = yaml.safe_load(Path(args.config).read_text())
@@ -100,6 +108,7 @@ def main() -> None:
     with_skip["mpm"]["skip_finest_tolerance"] = 0.05
     skippable = matrix.skippable_runs(with_skip)
     skippable_s = 0.0
+    skippable_ps = 0.0
     by_family = {"rigid-plastic": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0},
                  "real materials": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0}}
     for rid, scene_dict in matrix.all_runs(config).items():
@@ -109,6 +118,7 @@ def main() -> None:
         seconds = c.particle_steps / (throughput * (material_factor if real else 1.0))
         if rid in skippable:
             skippable_s += seconds
+            skippable_ps += c.particle_steps
         h = round(scene.discretisation.particle_size_m * 1e6, 6)
         row = by_size.setdefault(h, {"runs": 0, "particle_steps": 0.0, "largest_run_particles": 0, "projected_s": 0.0})
         row["runs"] += 1
@@ -135,13 +145,26 @@ def main() -> None:
     for name, fam in by_family.items():
         print(f"{name}: {fam['runs']} runs, {fam['particle_steps']:.3g} particle-steps, "
               f"{fam['projected_s'] / 3600:.1f} h")
+    bound = json.loads(Path(args.bandwidth_measured).read_text())["bandwidth_bound_particle_steps_per_s"]
+    target_s = args.target_h * 3600.0
+    all_ps = sum(r["particle_steps"] for r in by_size.values())
+    floor = {}
+    for name, ps in (("every run", all_ps), ("every skippable finest run skipped", all_ps - skippable_ps)):
+        floor[name] = {"particle_steps": ps, "at_bandwidth_bound_s": ps / bound,
+                       "throughput_needed_for_target": ps / target_s}
+        print(f"{name}: {ps:.3g} particle-steps; at the bandwidth bound ({bound / 1e6:.1f} M/s) "
+              f"{ps / bound / 3600:.1f} h; within {args.target_h:g} h it needs {ps / target_s / 1e6:.1f} M "
+              f"particle-steps/s ({ps / target_s / bound:.0%} of the bound, {ps / target_s / throughput:.1f}x "
+              "the rigid-plastic throughput used above)")
     out = {"config": args.config, "throughput_particle_steps_per_s": throughput,
            "graded_throughput_factor": graded_factor, "active_zone_throughput_factor": zone_factor,
            "real_material_throughput_factor": material_factor, "by_family": by_family,
            "active_zone_contact_radii": numerics.get("active_zone_contact_radii"),
            "graded": bool(numerics.get("graded", False)), "by_size_um": by_size,
            "total_projected_s": total, "skippable_runs": len(skippable),
-           "lower_bound_all_skipped_s": total - skippable_s}
+           "lower_bound_all_skipped_s": total - skippable_s,
+           "bandwidth_bound_particle_steps_per_s": bound, "bandwidth_measured": args.bandwidth_measured,
+           "target_s": target_s, "floor": floor}
     Path(args.out).write_text(json.dumps(out, indent=2) + "\n")
 
 
