@@ -170,8 +170,17 @@ BAD = {
                                      r"outputs\.initial_temperature_K = -500"),
     "a name with a path": (_mutate(name="../../escape/x"), r"name = '\.\./\.\./escape/x' is not allowed"),
     "a name with a space": (_mutate(name="my run"), r"name = 'my run' is not allowed"),
+    # unknown keys named as written, not as the SI key they were converted to
     "material dict missing keys": (_mutate(layers__substrate={"hardness_MPa": 450}),
-                                   r"layers\.substrate: not a material: missing key\(s\).*unknown key\(s\)"),
+                                   r"layers\.substrate: not a material: missing key\(s\).*"
+                                   r"unknown key\(s\) \['hardness_MPa'\]"),
+    "unknown unit key in a section": (_mutate(sphere__diameter_mm=1.0), r"sphere: unknown key\(s\) \['diameter_mm'\]"),
+    "unknown unit key in layers": (_mutate(layers__thickness_um=15), r"layers: unknown key\(s\) \['thickness_um'\]"),
+    "unknown unit key in a flow law": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {
+        "model": "constant", "sigma_y_Pa": 1e8, "sigma_u_MPa": 300}}),
+        r"layers\.substrate\.flow \(constant\): unknown key\(s\) \['sigma_u_MPa'\]"),
+    "rigid-plastic extra unit key": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": 900, "E_GPa": 200}),
+                                     r"unknown key\(s\) \['E_GPa'\] for a rigid-plastic material"),
     "material flow key unknown": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": "constant",
                                                                                         "sigma_y": 1e8}}),
                                   r"layers\.substrate\.flow \(constant\): missing key\(s\) \['sigma_y_Pa'\]"),

@@ -82,6 +82,18 @@ def _to_si(d: dict[str, Any], where: str = "") -> dict[str, Any]:
     return out
 
 
+def _as_given(keys: Any, given: dict[Any, Any]) -> list[str]:
+    """``keys`` (of the SI dict made by ``_to_si``) named as the user wrote them in ``given``:
+    ``hardness_MPa``, not the ``hardness_Pa`` it was converted to."""
+    back = {}
+    for k in given:
+        for suffix, (si_suffix, _) in _UNIT_SUFFIXES.items():
+            if isinstance(k, str) and k.endswith(suffix):
+                back[k[: -len(suffix)] + si_suffix] = k
+                break
+    return sorted(str(back.get(k, k)) for k in keys)
+
+
 def _coerce(value: Any, type_name: str, where: str) -> Any:
     """YAML 1.1 reads 1.0e6 as a string: convert numbers by the field's declared type."""
     if value is None or type_name not in ("float", "int", "float | None"):
@@ -103,11 +115,12 @@ def _mapping(d: Any, where: str) -> dict[str, Any]:
 
 
 def _from_dict(cls: type, d: dict[str, Any] | None, where: str) -> Any:
-    d = _to_si(_mapping(d, where), where)
+    given = _mapping(d, where)
+    d = _to_si(given, where)
     types = {f.name: str(f.type) for f in fields(cls)}
     unknown = set(d) - set(types)
     if unknown:
-        raise ValueError(f"{where}: unknown key(s) {sorted(map(str, unknown))}; allowed: {sorted(types)}")
+        raise ValueError(f"{where}: unknown key(s) {_as_given(unknown, given)}; allowed: {sorted(types)}")
     return cls(**{k: _coerce(v, types[k], f"{where}.{k}") for k, v in d.items()})
 
 
@@ -388,32 +401,34 @@ def material_from_spec(spec: Any, *, coating: bool, where: str) -> Material:
         if "rigid_plastic_hardness_Pa" in d:
             extra = set(d) - {"rigid_plastic_hardness_Pa", "name"}
             if extra:
-                raise ValueError(f"{where}: unknown key(s) {sorted(map(str, extra))} for a rigid-plastic material")
+                raise ValueError(f"{where}: unknown key(s) {_as_given(extra, spec)} for a rigid-plastic material")
             H = _number(d["rigid_plastic_hardness_Pa"], f"{where}.rigid_plastic_hardness_Pa")
             name = str(d.get("name", f"rigid_plastic_H{H / 1e6:g}MPa"))
             return rigid_plastic(name, H, coating=coating)
-        return Material.from_dict(_material_numbers(d, where))
+        return Material.from_dict(_material_numbers(d, where, spec))
     raise ValueError(f"{where} = {spec!r} is not a material name, a rigid-plastic hardness or a material dict")
 
 
-def _material_numbers(d: dict[str, Any], where: str) -> dict[str, Any]:
-    """A material dict with its keys checked and its numbers converted (``_MPa`` etc. in the flow
-    mapping too), so that ``Material.from_dict`` sees only what it can build."""
+def _material_numbers(d: dict[str, Any], where: str, given: dict[Any, Any]) -> dict[str, Any]:
+    """A material dict (``d``, in SI keys; ``given``, as written) with its keys checked and its numbers
+    converted (``_MPa`` etc. in the flow mapping too), so that ``Material.from_dict`` sees only what it
+    can build."""
     allowed = {f.name: str(f.type) for f in fields(Material)}
     missing = sorted(set(allowed) - set(d))
-    unknown = sorted(map(str, set(d) - set(allowed)))
+    unknown = _as_given(set(d) - set(allowed), given)
     if missing or unknown:
         raise ValueError(f"{where}: not a material: " + "; ".join(
             ([f"missing key(s) {missing}"] if missing else []) + ([f"unknown key(s) {unknown}"] if unknown else []))
             + f" (a material needs {sorted(allowed)}, or is a name of the materials data, or "
             "{rigid_plastic_hardness_MPa: H})")
     out = {k: _coerce(v, allowed[k], f"{where}.{k}") for k, v in d.items() if k != "flow"}
-    flow = _to_si(_mapping(d["flow"], f"{where}.flow"), f"{where}.flow")
+    given_flow = _mapping(d["flow"], f"{where}.flow")
+    flow = _to_si(given_flow, f"{where}.flow")
     model = flow.get("model")
     if not isinstance(model, str) or model not in FLOW_MODELS:
         raise ValueError(f"{where}.flow.model = {model!r} is not one of {list(FLOW_MODELS)}")
     types = {f.name: str(f.type) for f in fields(FLOW_MODELS[model])}
-    unknown = sorted(map(str, set(flow) - set(types) - {"model"}))
+    unknown = _as_given(set(flow) - set(types) - {"model"}, given_flow)
     missing = sorted(set(types) - set(flow))
     if missing or unknown:
         raise ValueError(f"{where}.flow ({model}): " + "; ".join(
@@ -616,10 +631,11 @@ class Scene:
             raise ValueError(f"scene: unknown key(s) {sorted(map(str, unknown))}; allowed: {sorted(allowed)}")
         if "layers" not in d:
             raise ValueError("scene: the key 'layers' (substrate, coating, coating_thickness) is required")
-        lay = _to_si(_mapping(d["layers"], "layers"), "layers")
+        given_layers = _mapping(d["layers"], "layers")
+        lay = _to_si(given_layers, "layers")
         unknown = set(lay) - {"substrate", "coating", "coating_thickness_m"}
         if unknown:
-            raise ValueError(f"layers: unknown key(s) {sorted(map(str, unknown))}")
+            raise ValueError(f"layers: unknown key(s) {_as_given(unknown, given_layers)}")
         if "substrate" not in lay:
             raise ValueError("layers.substrate is required")
         coating_spec = lay.get("coating")
