@@ -7,6 +7,7 @@ package sources that every rule takes as an input, as in a checkout.
 import copy
 import json
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -153,3 +154,58 @@ def test_smoke_skip_finest_writes_markers_where_the_coarser_sizes_agree(tmp_path
     assert 0 < n_skipped < len(finest_ids)
     assert int(ds["skipped_finest"].sum()) == n_skipped
     assert np.isfinite(ds["mu_h0"].values).all() and np.isfinite(ds["dp_h0"].values).all()
+
+
+class _Namespace:
+    def __init__(self, **kw):
+        self.__dict__.update(kw)
+
+
+def _run_script(tmp_path: Path, monkeypatch, config: dict, rid: str, error: Exception) -> tuple[Path, str]:
+    """workflow/scripts/mpm_run.py in-process with a fake snakemake object and a solver that raises ``error``."""
+    import runpy
+
+    import plough.mpm.run
+
+    def failing_simulate(*args, **kwargs):
+        raise error
+
+    monkeypatch.setattr(plough.mpm.run, "simulate", failing_simulate)
+    monkeypatch.setattr(sys, "stderr", sys.stderr)  # the script points it at its log; restored after
+    out, log = tmp_path / f"{rid}.nc", tmp_path / f"{rid}.log"
+    smk = _Namespace(params=_Namespace(scene=matrix.all_runs(config)[rid], skip_tolerance=None, coarser_sizes_um=None),
+                     input=_Namespace(coarser=[]), output=[str(out)], log=[str(log)], threads=1, config=config,
+                     wildcards=_Namespace(run=rid))
+    try:
+        runpy.run_path(str(ROOT / "workflow" / "scripts" / "mpm_run.py"), init_globals={"snakemake": smk})
+    finally:
+        text = log.read_text() if log.exists() else ""
+    return out, text
+
+
+def test_a_finest_run_that_stops_unstable_leaves_a_failure_marker(tmp_path, monkeypatch):
+    """mpm.finest_failure: record turns the solver's instability error of a finest sweep run into a failure
+    marker naming the error; with stop, at a coarser size, or for any other error the job fails and
+    writes nothing."""
+    from plough.mpm.solver import SimulationError
+    from plough.study import skipping
+
+    recordable = matrix.failure_recordable_runs(SMOKE)
+    finest = sorted(recordable)[0]
+    unstable = SimulationError("unstable run at step 12 (slid 3 um): a particle left the grid")
+    (tmp_path / "a").mkdir()
+    out, log = _run_script(tmp_path / "a", monkeypatch, SMOKE, finest, unstable)
+    marker = xr.load_dataset(out)
+    assert skipping.is_failed(marker) and "a particle left the grid" in marker.attrs["failure_reason"]
+    assert ", ".join(recordable[finest]) in marker.attrs["failure_stands_in"]
+    assert "recorded as a failure marker" in log and "a particle left the grid" in log
+
+    stop = copy.deepcopy(SMOKE)
+    stop["mpm"]["finest_failure"] = "stop"
+    coarse = recordable[finest][0]
+    for i, (config, rid, error) in enumerate([(stop, finest, unstable), (SMOKE, coarse, unstable),
+                                              (SMOKE, finest, ValueError("a refused scene"))]):
+        (tmp_path / str(i)).mkdir()
+        with pytest.raises(type(error), match=re.escape(str(error))):
+            _run_script(tmp_path / str(i), monkeypatch, config, rid, error)
+        assert not list((tmp_path / str(i)).glob("*.nc")), (rid, error)

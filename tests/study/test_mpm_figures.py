@@ -567,3 +567,71 @@ def test_sweep_figure_draws_each_runs_sampling_error(run_files):
     mpm_figures._sweep_panel(ax, ds.drop_vars(["mu_standard_error"]), "mu", "")
     assert not [c for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() == 0.3]
     plt.close(fig)
+
+
+def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_files, tmp_path):
+    """A failure marker at the finest size (mpm.finest_failure: record): the point's h -> 0 value is the
+    two-size extrapolation, flagged failed_finest (not skipped_finest); refused with finest_failure: stop
+    and at a coarser size."""
+    from plough.study import skipping
+
+    real = MPM["real_materials"]
+    loads = [float(x) for x in real["loads_N"]]
+    r1 = float(real["ball_radii_um"][0])
+    point = matrix.real_point(real, "zinc_block", loads[0], r1)
+    finest = matrix.run_id(point, min(SIZES))
+    paths = dict(run_files)
+    paths[finest] = tmp_path / f"{finest}.nc"
+    write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
+    assert finest in matrix.failure_recordable_runs(SMOKE)
+    ds = build_dataset(SMOKE, "fig15", paths)
+    sel = {"material": "zinc_block", "load_N": loads[0]}
+    sig = signature(loads[0], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer")
+    h3, h2 = sorted(SIZES, reverse=True)[:2]
+    gain = 1.0 / (h3 / h2 - 1.0)
+    for o in matrix.OUTPUTS:
+        f3, f2 = value(o, sig, h3), value(o, sig, h2)
+        assert float(ds[f"{o}_h0"].sel(sel)) == pytest.approx(f2 + (f2 - f3) * gain, rel=1e-12), o
+        assert int(ds[f"{o}_h0_method"].sel(sel)) == Method.TWO_SIZES_ASSUMED_ORDER
+        assert np.isnan(float(ds[o].sel(sel).sel(h=min(SIZES))))
+        _check_extrapolation(ds, o, {"material": "zinc_block", "load_N": loads[1]},
+                             signature(loads[1], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer"))
+    assert int(ds["failed_finest"].sum()) == 1 and int(ds["failed_finest"].sel(sel)) == 1
+    assert int(ds["skipped_finest"].sum()) == 0
+    _draws("fig15", _written(ds, tmp_path), tmp_path)
+
+    stop = copy.deepcopy(SMOKE)
+    stop["mpm"]["finest_failure"] = "stop"
+    with pytest.raises(ValueError, match="is a failure marker .*unstable run.*mpm.finest_failure is stop"):
+        build_dataset(stop, "fig15", paths)
+    coarse = matrix.run_id(point, max(SIZES))
+    paths = dict(run_files)
+    paths[coarse] = tmp_path / f"{coarse}.nc"
+    write_netcdf_atomic(skipping.failure_marker({"name": coarse}, coarse, "unstable run", []), paths[coarse])
+    with pytest.raises(ValueError, match=f"run '{coarse}' is a failure marker"):
+        build_dataset(SMOKE, "fig15", paths)
+
+
+def test_sweep_figure_rings_the_points_whose_finest_run_failed(run_files, tmp_path):
+    """A point extrapolated without its failed finest run gets a ring, once in the legend; none without one."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from plough.figures import mpm as mpm_figures
+    from plough.study import skipping
+
+    real = MPM["real_materials"]
+    point = matrix.real_point(real, "zinc_block", float(real["loads_N"][0]), float(real["ball_radii_um"][0]))
+    finest = matrix.run_id(point, min(SIZES))
+    paths = dict(run_files)
+    paths[finest] = tmp_path / f"{finest}.nc"
+    write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
+    for data, rings in ((build_dataset(SMOKE, "fig15", paths), 1), (build_dataset(SMOKE, "fig15", run_files), 0)):
+        fig, ax = plt.subplots()
+        mpm_figures._sweep_panel(ax, data, "dp", "")
+        ringed = [line for line in ax.lines if line.get_marker() == "o" and line.get_markersize() == 11]
+        assert sum(len(line.get_xdata()) for line in ringed) == rings
+        assert sum(1 for line in ringed if not line.get_label().startswith("_")) == rings
+        plt.close(fig)

@@ -100,3 +100,35 @@ def test_a_newer_run_without_its_dp_error_never_skips():
     ex = skipping.two_size_extrapolation(coarse, newer, 20.0, 10.0)
     assert np.isnan(ex["dp"]["sampling_error"]) and ex["mu"]["sampling_error"] == 0.0
     assert not skipping.should_skip(ex, 0.5)
+
+
+def test_failure_marker_carries_the_message_and_no_results():
+    m = skipping.failure_marker({"name": "p_h5"}, "p_h5", "unstable run at step 7: a particle left the grid",
+                                ["p_h20", "p_h10"])
+    assert skipping.is_failed(m) and not skipping.is_skipped(m)
+    assert not skipping.is_failed(_run(0.4, 1e-6))
+    assert not m.data_vars
+    assert "a particle left the grid" in m.attrs["failure_reason"] and "p_h5" in m.attrs["failure_reason"]
+    assert "p_h20, p_h10" in m.attrs["failure_stands_in"]
+    assert json.loads(m.attrs["scene"]) == {"name": "p_h5"} and m.attrs["plough_version"]
+
+
+def test_failure_recordable_runs_follow_mpm_finest_failure():
+    """record (the default, also when the key is absent): every finest sweep run that is not a picture's,
+    the same runs skipping may skip; stop: none; an unknown choice is refused by name."""
+    with_skip = copy.deepcopy(SMOKE)
+    with_skip["mpm"]["skip_finest_tolerance"] = 0.05
+    assert SMOKE["mpm"]["finest_failure"] == "record"
+    assert matrix.failure_recordable_runs(SMOKE) == matrix.skippable_runs(with_skip) != {}
+    absent = copy.deepcopy(SMOKE)
+    del absent["mpm"]["finest_failure"]
+    assert matrix.failure_recordable_runs(absent) == matrix.failure_recordable_runs(SMOKE)
+    stop = copy.deepcopy(SMOKE)
+    stop["mpm"]["finest_failure"] = "stop"
+    assert matrix.failure_recordable_runs(stop) == {}
+    stop["mpm"]["finest_failure"] = "ignore"
+    with pytest.raises(ValueError, match="mpm.finest_failure = 'ignore' is unknown; allowed: record, stop"):
+        matrix.failure_recordable_runs(stop)
+    two = copy.deepcopy(SMOKE)
+    two["mpm"]["particle_sizes_um"] = [20, 10]
+    assert matrix.failure_recordable_runs(two) == {}  # nothing to stand in for the finest run

@@ -2,6 +2,9 @@
 
 A finest-size run with ``params.skip_tolerance`` set first extrapolates its point's two coarser
 runs; within the tolerance it writes a skip marker instead of running (plough.study.skipping).
+A finest sweep run that stops unstable writes a failure marker instead of failing the job when the
+config's ``mpm.finest_failure`` is ``record`` (read here, not a param, so that changing it does not
+rerun the finest runs that succeeded).
 """
 
 import sys
@@ -12,7 +15,8 @@ from plough.io import write_netcdf_atomic
 from plough.mpm.io import write_result
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
-from plough.study import skipping
+from plough.mpm.solver import SimulationError
+from plough.study import matrix, skipping
 
 smk = snakemake  # noqa: F821 - injected by Snakemake
 
@@ -40,9 +44,16 @@ with open(smk.log[0], "w", buffering=1) as log:
     if not skipped(log):
         try:
             ds = simulate(scene, progress=True, threads=smk.threads)
-        except Exception as exc:  # the solver's message in the log, then the job fails
+        except Exception as exc:  # the solver's message in the log, then the job fails (or the marker)
             print(f"\nrun {scene.name} failed: {type(exc).__name__}: {exc}", file=log)
-            raise
-        write_result(ds, smk.output[0])
-        print(f"\nwrote {smk.output[0]}: mu = {float(ds.mu):.4g}, dp = {float(ds.dp):.4g} m, "
-              f"{ds.attrs['cost_wall_time_s']:.1f} s wall", file=log)
+            coarser = matrix.failure_recordable_runs(smk.config).get(smk.wildcards.run)
+            if not (isinstance(exc, SimulationError) and coarser):
+                raise
+            write_netcdf_atomic(skipping.failure_marker(smk.params.scene, smk.wildcards.run, str(exc), list(coarser)),
+                                smk.output[0])
+            print(f"recorded as a failure marker (mpm.finest_failure: record): {smk.output[0]}; the figure "
+                  f"dataset extrapolates this point from {', '.join(coarser)}", file=log)
+        else:
+            write_result(ds, smk.output[0])
+            print(f"\nwrote {smk.output[0]}: mu = {float(ds.mu):.4g}, dp = {float(ds.dp):.4g} m, "
+                  f"{ds.attrs['cost_wall_time_s']:.1f} s wall", file=log)

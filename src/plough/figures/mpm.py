@@ -46,6 +46,7 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
     steady = ds.get(f"steady{suffix}")  # per run; absent for result files from before the check
     error = ds.get(f"{quantity}_standard_error{suffix}")  # per run (mu, mu_pl, mu_sh, dp); absent in old files
     unsteady_label = "run not steady (mu_drift or prow growth in its window)"
+    failed_label = "finest run stopped unstable: from the two coarser sizes"
     for i, label in enumerate(ds[series_dim].values):
         colour = SERIES_COLOURS[i % len(SERIES_COLOURS)]
         sel = {series_dim: label}
@@ -72,6 +73,13 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
         if flagged.any():
             ax.errorbar(x[flagged], val[flagged], yerr=unc[flagged], fmt="o", mfc="white", color=colour, capsize=3,
                         label="MPM h -> 0, flagged (not converged: least squares / two sizes)")
+        failed = ds.get(f"failed_finest{suffix}")  # absent in datasets from before mpm.finest_failure
+        if failed is not None:
+            stopped = failed.sel(sel).values.astype(bool)
+            if stopped.any():
+                ax.plot(x[stopped], val[stopped], ls="none", marker="o", ms=11, mfc="none", mec="k", mew=0.8,
+                        label=failed_label)
+                failed_label = None
         ana = f"{quantity}_analytical{suffix}"
         if ana in ds:
             ax.plot(x, ds[ana].sel(sel) * scale, color=colour, lw=1.3, label=f"analytical, {_label(label)}")
@@ -100,7 +108,8 @@ def _scene_note(ds: xr.Dataset) -> str:
     return f"Particle sizes h = {', '.join(f'{h:g}' for h in ds['h'].values)} µm; marks: extrapolated to h -> 0 " \
            "(Richardson; bars: Roache GCI and the runs' sampling errors carried to the limit, in quadrature, " \
            "the GCI alone where a run's error is missing; " \
-           "hollow = fallback, flagged), faint: per size with the run's sampling standard error; " \
+           "hollow = fallback, flagged; ringed = the finest run stopped unstable, from the two coarser sizes), " \
+           "faint: per size with the run's sampling standard error; " \
            "lines: analytical model."
 
 

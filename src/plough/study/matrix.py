@@ -41,6 +41,9 @@ ANALYTICAL_OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp")
 SWEEP_FIGURES = ("fig11", "fig13", "fig15", "fig16", "fig18", "fig20", "fig21", "fig23")
 SINGLE_RUN_FIGURES = ("fig12", "fig14", "fig17", "fig19")
 MPM_FIGURES = tuple(sorted(SWEEP_FIGURES + SINGLE_RUN_FIGURES))
+#: ``mpm.finest_failure``: what a finest sweep run that stops unstable leaves (README, "Rebuild one figure")
+FINEST_FAILURE_CHOICES = ("record", "stop")
+FINEST_FAILURE_DEFAULT = "record"
 
 AXES = {
     "hardness_ratio": ("1", "coating to substrate hardness ratio H~ = Hc / Hs"),
@@ -305,6 +308,25 @@ def skippable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
     are at least three sizes; never a run a picture (single-run figure) needs."""
     if config["mpm"].get("skip_finest_tolerance") is None:
         return {}
+    return finest_sweep_runs(config)
+
+
+def failure_recordable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
+    """The finest sweep runs (as :func:`finest_sweep_runs`) whose stop on the solver's instability
+    error is recorded as a failure marker (``plough.study.skipping``) instead of failing the
+    workflow: all of them with ``mpm.finest_failure: record`` (the default), none with ``stop``."""
+    choice = config["mpm"].get("finest_failure", FINEST_FAILURE_DEFAULT)
+    if choice not in FINEST_FAILURE_CHOICES:
+        raise ValueError(f"mpm.finest_failure = {choice!r} is unknown; allowed: {', '.join(FINEST_FAILURE_CHOICES)}")
+    if choice != "record":
+        return {}
+    return finest_sweep_runs(config)
+
+
+def finest_sweep_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
+    """finest-size run id -> (coarsest, middle) run ids of the same point, for every sweep point
+    whose value two coarser sizes could stand in for: empty with fewer than three sizes; never a run
+    a picture (single-run figure) needs."""
     sizes = particle_sizes_um(config)
     if len(sizes) < 3:
         return {}

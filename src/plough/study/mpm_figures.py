@@ -26,7 +26,7 @@ from plough.io import provenance_attrs
 from plough.mpm.io import STANDARD_ERROR_META, STEADINESS_META, STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import extrapolate_dataarray, sampling_error
-from plough.study.skipping import is_skipped
+from plough.study.skipping import is_failed, is_skipped
 
 TITLES = {
     "fig11": "Fig. 11 - ploughing depth dp, MPM vs analytical, rigid-plastic coating",
@@ -64,9 +64,11 @@ def load_runs(run_ids: list[str], paths: Mapping[str, str | Path]) -> dict[str, 
 
 
 def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mapping[str, xr.Dataset],
-                   suffix: str, skippable: Collection[str] = ()) -> xr.Dataset:
+                   suffix: str, skippable: Collection[str] = (), recordable: Collection[str] = ()) -> xr.Dataset:
     """One panel's per-size values and their h -> 0 extrapolation. ``sizes_um`` descending; a run in
-    ``skippable`` (``matrix.skippable_runs``) may be a skip marker, any other marker is refused."""
+    ``skippable`` (``matrix.skippable_runs``) may be a skip marker, one in ``recordable``
+    (``matrix.failure_recordable_runs``) a failure marker; any other marker is refused. Either way
+    the point is extrapolated from the two coarser sizes."""
     labels = [s.label for s in panel.series]
     ax_units, ax_long = matrix.AXES[panel.axis]
     coords = {
@@ -83,6 +85,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     errors = {name: np.full(shape, np.nan) for name in STANDARD_ERROR_META}
     analytical = {o: np.full(shape[:2], np.nan) for o in matrix.ANALYTICAL_OUTPUTS}
     skipped = np.zeros(shape[:2], dtype=bool)
+    failed = np.zeros(shape[:2], dtype=bool)
     for i, series in enumerate(panel.series):
         for j, point in enumerate(series.points):
             for k, h in enumerate(sizes_um):
@@ -94,6 +97,14 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                                          "(mpm.skip_finest_tolerance is null, fewer than three sizes, not the "
                                          "finest size, or a picture's run); delete the file and rerun")
                     skipped[i, j] = True
+                    continue
+                if is_failed(ds):
+                    if rid not in recordable:
+                        raise ValueError(f"run {rid!r} is a failure marker ({ds.attrs.get('failure_reason')}), but "
+                                         "the config does not allow one there (mpm.finest_failure is stop, fewer "
+                                         "than three sizes, not the finest size, or a picture's run); delete the "
+                                         "file and rerun")
+                    failed[i, j] = True
                     continue
                 for o in per_size:
                     per_size[o][i, j, k] = float(ds[o])
@@ -107,20 +118,21 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                 analytical[o][i, j] = v
     dims3 = (panel.series_dim, panel.axis, "h")
     out = xr.Dataset(coords=coords)
+    two_sizes = skipped | failed  # points extrapolated from the two coarser sizes
     for o, values in per_size.items():
         units, long_name = STEADY_META[o]
         da = xr.DataArray(values, dims=dims3, coords=coords, name=o,
                           attrs={"units": units, "long_name": f"{long_name} (MPM, per particle size)",
-                                 **({"allow_missing": 1} if skipped.any() else {})})
+                                 **({"allow_missing": 1} if two_sizes.any() else {})})
         out[o + suffix] = da
         if o not in matrix.OUTPUTS:
             continue
         ex = extrapolate_dataarray(da, "h")
-        # points whose finest run was skipped: the two coarser sizes' extrapolation (flagged)
-        ex_coarse = extrapolate_dataarray(da.sel(h=list(sizes_um[-3:-1])), "h") if skipped.any() else ex
+        # points whose finest run was skipped or failed: the two coarser sizes' extrapolation (flagged)
+        ex_coarse = extrapolate_dataarray(da.sel(h=list(sizes_um[-3:-1])), "h") if two_sizes.any() else ex
         for field in ("value", "uncertainty", "order", "method", "flagged"):
             name = f"{o}_h0{suffix}" if field == "value" else f"{o}_h0_{field}{suffix}"
-            var = ex[field].copy(data=np.where(skipped, ex_coarse[field].values, ex[field].values))
+            var = ex[field].copy(data=np.where(two_sizes, ex_coarse[field].values, ex[field].values))
             if var.dtype == bool:
                 var = var.astype(np.int8)
             if field == "order":
@@ -129,7 +141,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
         se = errors.get(f"{o}_standard_error")
         if se is not None and np.isfinite(se).any():
             out[f"{o}_h0_sampling_error{suffix}"] = (
-                (panel.series_dim, panel.axis), _limit_sampling_error(sizes_um, values, se, skipped),
+                (panel.series_dim, panel.axis), _limit_sampling_error(sizes_um, values, se, two_sizes),
                 {"units": units, "allow_missing": 1,
                  "long_name": f"standard error of {o} extrapolated to h -> 0 from the runs' sampling errors "
                               "(linear propagation; missing where a needed run's error is)"})
@@ -139,32 +151,35 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                                           {"units": units, "long_name": f"{long_name} (analytical model, eqs. 1-5)",
                                            "allow_missing": 1})
     out[f"wall_time_s{suffix}"] = (dims3, wall, {"units": "s", "long_name": "wall time of the run",
-                                                 **({"allow_missing": 1} if skipped.any() else {})})
+                                                 **({"allow_missing": 1} if two_sizes.any() else {})})
     if np.isfinite(steady).any():  # result files written before the check carry none
         out[f"steady{suffix}"] = (dims3, steady, {"units": "1", "allow_missing": 1,
                                                   "long_name": STEADINESS_META["steady"][1] + " (per run; missing: "
-                                                  "skipped, or written before the check)"})
+                                                  "skipped, failed, or written before the check)"})
     for name, values in errors.items():
         if np.isfinite(values).any():
             units, long_name = STANDARD_ERROR_META[name]
             out[name + suffix] = (dims3, values, {"units": units, "allow_missing": 1,
-                                                  "long_name": f"{long_name} (per run; missing: skipped, not "
+                                                  "long_name": f"{long_name} (per run; missing: skipped, failed, not "
                                                                "estimable, or written before it was)"})
     out[f"skipped_finest{suffix}"] = ((panel.series_dim, panel.axis), skipped.astype(np.int8),
                                       {"units": "1", "long_name": "finest size skipped (mpm.skip_finest_tolerance): "
                                        "extrapolated from the two coarser sizes"})
+    out[f"failed_finest{suffix}"] = ((panel.series_dim, panel.axis), failed.astype(np.int8),
+                                     {"units": "1", "long_name": "finest run stopped unstable (mpm.finest_failure: "
+                                      "record): extrapolated from the two coarser sizes"})
     return out
 
 
 def _limit_sampling_error(sizes_um: tuple[float, ...], values: np.ndarray, se: np.ndarray,
-                          skipped: np.ndarray) -> np.ndarray:
+                          two_sizes: np.ndarray) -> np.ndarray:
     """The runs' sampling errors carried through the h -> 0 extrapolation (the two coarser sizes' where
-    the finest run was skipped)."""
+    the finest run was skipped or failed)."""
     h = np.asarray(sizes_um, dtype=float)
     out = sampling_error(h, values, se)
-    if skipped.any():
+    if two_sizes.any():
         coarse = sampling_error(h[-3:-1], values[..., -3:-1], se[..., -3:-1])
-        out = np.where(skipped, coarse, out)
+        out = np.where(two_sizes, coarse, out)
     return out
 
 
@@ -172,7 +187,9 @@ def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dat
     panels = matrix.figure_panels(config, figure)
     sizes = matrix.particle_sizes_um(config)
     skippable = set(matrix.skippable_runs(config))
-    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", skippable) for p in panels]
+    recordable = set(matrix.failure_recordable_runs(config))
+    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", skippable, recordable)
+             for p in panels]
     ds = xr.merge(parts, combine_attrs="drop_conflicts", join="exact")
     ds.attrs["panels"] = ",".join(p.name for p in panels)
     if figure in ("fig11", "fig13"):

@@ -14,6 +14,15 @@ extrapolations), and the figure dataset extrapolates that point from the two coa
 skipping that run is refused by the dataset builder.
 
 Default off (``null``): the faithful reproduction runs every size.
+
+**Failure markers.** A finest sweep run may also stop unstable (``plough.mpm.solver.SimulationError``:
+at h = 2.5 um a prow can grow until material leaves the grid, README *Status*). With
+``mpm.finest_failure: record`` (the default) its result file is then a *failure marker* (no result
+variables; the solver's message, the run id and provenance as attributes) and the figure dataset
+extrapolates that point from the two coarser sizes, as for a skipped run, flagged ``failed_finest``.
+With ``stop`` the job fails and the workflow with it. Any other error (a refused scene, a bug)
+always fails the job, and a failure marker where the config does not allow one is refused by the
+dataset builder.
 """
 
 from __future__ import annotations
@@ -31,6 +40,7 @@ from plough.study.extrapolation import extrapolate, sampling_error
 #: Outputs whose two-size extrapolation must be within the tolerance to skip the finest run.
 CHECKED = ("mu", "dp")
 SKIPPED_ATTR = "skipped_finest_size"
+FAILED_ATTR = "failed_finest_size"
 
 
 def two_size_extrapolation(coarse: xr.Dataset, mid: xr.Dataset, h_coarse_um: float, h_mid_um: float,
@@ -88,3 +98,19 @@ def skip_marker(scene: dict[str, Any], extrapolations: dict[str, dict[str, float
 
 def is_skipped(ds: xr.Dataset) -> bool:
     return bool(ds.attrs.get(SKIPPED_ATTR, 0))
+
+
+def failure_marker(scene: dict[str, Any], run_id: str, message: str, coarse_runs: list[str]) -> xr.Dataset:
+    """The result file of a finest sweep run that stopped unstable: no result variables; the solver's
+    message, the run and the two coarser runs that stand in for it, and provenance, as attributes."""
+    return xr.Dataset(attrs={
+        FAILED_ATTR: 1,
+        "failure_reason": f"run {run_id} stopped: {message}",
+        "failure_stands_in": (f"the two-size extrapolation of {', '.join(coarse_runs)} "
+                              "(mpm.finest_failure: record)"),
+        **provenance_attrs(scene, key="scene"),
+    })
+
+
+def is_failed(ds: xr.Dataset) -> bool:
+    return bool(ds.attrs.get(FAILED_ATTR, 0))
