@@ -20,7 +20,8 @@ from plough.mpm.scene import Scene
 from plough.study import matrix
 
 ROOT = Path(__file__).resolve().parents[2]
-CONFIGS = {name: yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text()) for name in ("config", "smoke")}
+CONFIGS = {name: yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text())
+           for name in ("config", "preview", "smoke")}
 
 
 @pytest.fixture(params=sorted(CONFIGS), scope="module")
@@ -372,3 +373,17 @@ def test_grid_headroom_reaches_every_scene_of_the_matrix(config, mode):
         assert Scene.from_dict(before[rid]).domain.headroom_m is None
         assert Scene.from_dict(d).domain.headroom_m == pytest.approx(120e-6)
         assert Scene.from_dict(d).grid_headroom_m == pytest.approx(120e-6)
+
+
+def test_preview_config_is_the_full_matrix_at_two_coarser_sizes():
+    """config/preview.yaml differs from config/config.yaml only in the particle sizes (so it follows the full
+    matrix as that changes), and its h = 10 um runs are the full config's own scenes: one result file serves both."""
+    full, preview = CONFIGS["config"], CONFIGS["preview"]
+    assert matrix.particle_sizes_um(preview) == (20.0, 10.0)
+    same = copy.deepcopy(preview)
+    same["mpm"]["particle_sizes_um"] = full["mpm"]["particle_sizes_um"]
+    assert same == full
+    runs_full, runs_preview = matrix.all_runs(full), matrix.all_runs(preview)
+    at_10 = {rid: scene for rid, scene in runs_preview.items() if rid.endswith("_h10")}
+    assert len(at_10) == len(runs_preview) // 2 == len(runs_full) // 3
+    assert all(runs_full[rid] == scene for rid, scene in at_10.items())
