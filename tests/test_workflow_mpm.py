@@ -185,26 +185,30 @@ def _run_script(tmp_path: Path, monkeypatch, config: dict, rid: str, error: Exce
 
 def test_a_finest_run_that_stops_unstable_leaves_a_failure_marker(tmp_path, monkeypatch):
     """mpm.finest_failure: record turns the solver's instability error of a finest sweep run into a failure
-    marker naming the error; with stop, at a coarser size, or for any other error the job fails and
-    writes nothing."""
-    from plough.mpm.solver import SimulationError
+    marker naming the error; with stop (the smoke config), at a coarser size, for a picture's run, for lost
+    contact or any other error the job fails and writes nothing."""
+    from plough.mpm.solver import InstabilityError, SimulationError
     from plough.study import skipping
 
-    recordable = matrix.failure_recordable_runs(SMOKE)
+    record = copy.deepcopy(SMOKE)
+    record["mpm"]["finest_failure"] = "record"
+    recordable = matrix.failure_recordable_runs(record)
     finest = sorted(recordable)[0]
-    unstable = SimulationError("unstable run at step 12 (slid 3 um): a particle left the grid")
+    unstable = InstabilityError("unstable run at step 12 (slid 3 um): a particle left the grid")
     (tmp_path / "a").mkdir()
-    out, log = _run_script(tmp_path / "a", monkeypatch, SMOKE, finest, unstable)
+    out, log = _run_script(tmp_path / "a", monkeypatch, record, finest, unstable)
     marker = xr.load_dataset(out)
     assert skipping.is_failed(marker) and "a particle left the grid" in marker.attrs["failure_reason"]
     assert ", ".join(recordable[finest]) in marker.attrs["failure_stands_in"]
     assert "recorded as a failure marker" in log and "a particle left the grid" in log
 
-    stop = copy.deepcopy(SMOKE)
-    stop["mpm"]["finest_failure"] = "stop"
     coarse = recordable[finest][0]
-    for i, (config, rid, error) in enumerate([(stop, finest, unstable), (SMOKE, coarse, unstable),
-                                              (SMOKE, finest, ValueError("a refused scene"))]):
+    picture = matrix.figure_runs(record, "fig19")[0]  # a picture's finest run, also a sweep point
+    assert picture.endswith(f"_h{matrix.fmt(min(matrix.particle_sizes_um(record)))}") and picture not in recordable
+    lost = SimulationError("the sphere lost contact while sliding")
+    for i, (config, rid, error) in enumerate([(SMOKE, finest, unstable), (record, coarse, unstable),
+                                              (record, picture, unstable), (record, finest, lost),
+                                              (record, finest, ValueError("a refused scene"))]):
         (tmp_path / str(i)).mkdir()
         with pytest.raises(type(error), match=re.escape(str(error))):
             _run_script(tmp_path / str(i), monkeypatch, config, rid, error)

@@ -583,8 +583,10 @@ def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_file
     paths = dict(run_files)
     paths[finest] = tmp_path / f"{finest}.nc"
     write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
-    assert finest in matrix.failure_recordable_runs(SMOKE)
-    ds = build_dataset(SMOKE, "fig15", paths)
+    record = copy.deepcopy(SMOKE)
+    record["mpm"]["finest_failure"] = "record"
+    assert finest in matrix.failure_recordable_runs(record)
+    ds = build_dataset(record, "fig15", paths)
     sel = {"material": "zinc_block", "load_N": loads[0]}
     sig = signature(loads[0], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer")
     h3, h2 = sorted(SIZES, reverse=True)[:2]
@@ -600,16 +602,14 @@ def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_file
     assert int(ds["skipped_finest"].sum()) == 0
     _draws("fig15", _written(ds, tmp_path), tmp_path)
 
-    stop = copy.deepcopy(SMOKE)
-    stop["mpm"]["finest_failure"] = "stop"
     with pytest.raises(ValueError, match="is a failure marker .*unstable run.*mpm.finest_failure is stop"):
-        build_dataset(stop, "fig15", paths)
+        build_dataset(SMOKE, "fig15", paths)  # the smoke config stops on a failed run
     coarse = matrix.run_id(point, max(SIZES))
     paths = dict(run_files)
     paths[coarse] = tmp_path / f"{coarse}.nc"
     write_netcdf_atomic(skipping.failure_marker({"name": coarse}, coarse, "unstable run", []), paths[coarse])
     with pytest.raises(ValueError, match=f"run '{coarse}' is a failure marker"):
-        build_dataset(SMOKE, "fig15", paths)
+        build_dataset(record, "fig15", paths)
 
 
 def test_sweep_figure_rings_the_points_whose_finest_run_failed(run_files, tmp_path):
@@ -628,10 +628,66 @@ def test_sweep_figure_rings_the_points_whose_finest_run_failed(run_files, tmp_pa
     paths = dict(run_files)
     paths[finest] = tmp_path / f"{finest}.nc"
     write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
-    for data, rings in ((build_dataset(SMOKE, "fig15", paths), 1), (build_dataset(SMOKE, "fig15", run_files), 0)):
+    record = copy.deepcopy(SMOKE)
+    record["mpm"]["finest_failure"] = "record"
+    for data, rings in ((build_dataset(record, "fig15", paths), 1), (build_dataset(record, "fig15", run_files), 0)):
         fig, ax = plt.subplots()
         mpm_figures._sweep_panel(ax, data, "dp", "")
         ringed = [line for line in ax.lines if line.get_marker() == "o" and line.get_markersize() == 11]
         assert sum(len(line.get_xdata()) for line in ringed) == rings
         assert sum(1 for line in ringed if not line.get_label().startswith("_")) == rings
         plt.close(fig)
+
+
+def test_fig22_carries_and_draws_a_failed_finest_run_of_fig21(run_files, tmp_path):
+    """Fig. 22's MPM points keep Fig. 21's flags: a point whose finest run failed is flagged, marked failed
+    and ringed in the plot; the others are not."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+
+    from plough.figures import analytical as analytical_figures
+    from plough.study import skipping
+
+    record = copy.deepcopy(SMOKE)
+    record["mpm"]["finest_failure"] = "record"
+    real = MPM["real_materials"]
+    loads = [float(x) for x in real["loads_N"]]
+    r_last = float(real["ball_radii_um"][-1])
+    point = matrix.real_point(real, "coated", loads[-1], r_last)
+    finest = matrix.run_id(point, min(SIZES))
+    assert finest in matrix.failure_recordable_runs(record)
+    paths = dict(run_files)
+    paths[finest] = tmp_path / f"{finest}.nc"
+    write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
+    ds = build_dataset(record, "fig22", paths)
+    sel = {"ball_diameter_mm": 2 * r_last / 1000, "mpm_load_N": loads[-1]}
+    assert int(ds["mu_mpm_failed_finest"].sum()) == 1 and int(ds["mu_mpm_failed_finest"].sel(sel)) == 1
+    assert int(ds["mu_mpm_flagged"].sel(sel)) == 1
+    fig21 = build_dataset(record, "fig21", paths)
+    np.testing.assert_array_equal(ds["mu_mpm_flagged"].values, fig21["mu_h0_flagged"].values)
+    rings = []
+    real_save = analytical_figures.save
+    try:
+        analytical_figures.save = lambda fig, outputs: rings.extend(
+            line for ax in fig.axes for line in ax.lines if line.get_marker() == "o" and line.get_markersize() == 11)
+        analytical_figures.plot_fig22(_written(ds, tmp_path), [tmp_path / "f.png"])
+    finally:
+        analytical_figures.save = real_save
+    assert sum(len(line.get_xdata()) for line in rings) == 1
+
+
+def test_a_marker_at_a_pictures_run_is_refused_naming_it(run_files, tmp_path):
+    """A picture draws its finest run itself: a failure or skip marker there (a copied results/runs/) is an
+    error naming the run and its reason, not a KeyError."""
+    from plough.study import skipping
+
+    rid = matrix.figure_runs(SMOKE, "fig19")[0]
+    paths = dict(run_files)
+    paths[rid] = tmp_path / f"{rid}.nc"
+    write_netcdf_atomic(skipping.failure_marker({"name": rid}, rid, "a particle left the grid", []), paths[rid])
+    with pytest.raises(ValueError, match=f"run '{rid}' is a failure marker .*a particle left the grid.*fig19 draws"):
+        build_dataset(SMOKE, "fig19", paths)
+    write_netcdf_atomic(skipping.skip_marker({"name": rid}, {}, 0.1, ["a.nc"]), paths[rid])
+    with pytest.raises(ValueError, match=f"run '{rid}' is a skip marker"):
+        build_dataset(SMOKE, "fig19", paths)

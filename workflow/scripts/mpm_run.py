@@ -2,7 +2,8 @@
 
 A finest-size run with ``params.skip_tolerance`` set first extrapolates its point's two coarser
 runs; within the tolerance it writes a skip marker instead of running (plough.study.skipping).
-A finest sweep run that stops unstable writes a failure marker instead of failing the job when the
+A finest sweep run that stops unstable (``InstabilityError``: not a refused scene, a load it cannot
+reach or lost contact) writes a failure marker instead of failing the job when the
 config's ``mpm.finest_failure`` is ``record`` (read here, not a param, so that changing it does not
 rerun the finest runs that succeeded).
 """
@@ -15,7 +16,7 @@ from plough.io import write_netcdf_atomic
 from plough.mpm.io import write_result
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
-from plough.mpm.solver import SimulationError
+from plough.mpm.solver import InstabilityError
 from plough.study import matrix, skipping
 
 smk = snakemake  # noqa: F821 - injected by Snakemake
@@ -47,7 +48,7 @@ with open(smk.log[0], "w", buffering=1) as log:
         except Exception as exc:  # the solver's message in the log, then the job fails (or the marker)
             print(f"\nrun {scene.name} failed: {type(exc).__name__}: {exc}", file=log)
             coarser = matrix.failure_recordable_runs(smk.config).get(smk.wildcards.run)
-            if not (isinstance(exc, SimulationError) and coarser):
+            if not (isinstance(exc, InstabilityError) and coarser):
                 raise
             write_netcdf_atomic(skipping.failure_marker(smk.params.scene, smk.wildcards.run, str(exc), list(coarser)),
                                 smk.output[0])

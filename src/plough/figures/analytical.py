@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import os
 
+import numpy as np
 import xarray as xr
 
 from plough.figures.style import COLOURS, LABELS, caption, new_figure, save, shade_where
@@ -89,7 +90,19 @@ def plot_fig22(ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
         if "mu_mpm" in ds:
             mpm = ds["mu_mpm"].sel(ball_diameter_mm=d)
             unc = ds["mu_mpm_uncertainty"].sel(ball_diameter_mm=d)
-            ax.errorbar(ds["mpm_load_N"], mpm, yerr=unc, fmt="o", color="k", label="MPM (h -> 0)")
+            x = ds["mpm_load_N"].values
+            flagged = (ds["mu_mpm_flagged"].sel(ball_diameter_mm=d).values.astype(bool) if "mu_mpm_flagged" in ds
+                       else np.zeros(x.shape, dtype=bool))  # datasets from before the flags carry none
+            ax.errorbar(x[~flagged], mpm.values[~flagged], yerr=unc.values[~flagged], fmt="o", color="k",
+                        label="MPM (h -> 0)")
+            if flagged.any():
+                ax.errorbar(x[flagged], mpm.values[flagged], yerr=unc.values[flagged], fmt="o", mfc="white",
+                            color="k", label="MPM (h -> 0), flagged (least squares / two sizes)")
+            if "mu_mpm_failed_finest" in ds:
+                stopped = ds["mu_mpm_failed_finest"].sel(ball_diameter_mm=d).values.astype(bool)
+                if stopped.any():
+                    ax.plot(x[stopped], mpm.values[stopped], ls="none", marker="o", ms=11, mfc="none", mec="k",
+                            mew=0.8, label="finest run stopped unstable: from the two coarser sizes")
         ax.set_yscale("log")
         ax.set_xlabel("normal load Fn (N)")
         ax.set_ylabel("friction coefficient (-)")

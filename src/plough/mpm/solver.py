@@ -61,7 +61,13 @@ ZONE_PAD_CELLS = 4
 
 
 class SimulationError(RuntimeError):
-    """A run went unstable; the message names the step, the sliding distance and the likely cause."""
+    """A run could not finish: the message names the step, the sliding distance and the likely cause."""
+
+
+class InstabilityError(SimulationError):
+    """The state went unstable while running (non-finite values, J out of range, a particle leaving the
+    grid, kinetic energy out of proportion), as opposed to a run that cannot reach its load or loses
+    contact: the workflow may record it for a finest-size run (``mpm.finest_failure``)."""
 
 
 @dataclass
@@ -454,11 +460,11 @@ def check_stability(s: State, c: Constants) -> None:
                      f"{zone.check_hi_m[0] * 1e6:.1f} um), about a cell past its start at the zone's end: material "
                      "the sphere pushes beyond the zone (widen discretisation.active_zone_contact_radii, or switch "
                      "it off)")
-        raise SimulationError(f"unstable run {where}: {cause}{_particle_report(s, c, index)}")
+        raise InstabilityError(f"unstable run {where}: {cause}{_particle_report(s, c, index)}")
     kinetic = float(acc[:, transfers.ACC_KINETIC].sum())
     budget = 2.0 * abs(s.work.external_work) + c.load_N * c.grid.dx
     if kinetic > budget:
-        raise SimulationError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
+        raise InstabilityError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
                               f"by the sphere ({s.work.external_work:.3g} J): inertia dominates; lower "
                               "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")
 

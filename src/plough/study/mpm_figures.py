@@ -205,7 +205,12 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
     with_steady = all("steady" in runs[matrix.run_id(p, h)] for p in cases.values())
     parts = []
     for label, point in cases.items():
-        run = runs[matrix.run_id(point, h)]
+        rid = matrix.run_id(point, h)
+        run = runs[rid]
+        if is_skipped(run) or is_failed(run):
+            reason = run.attrs.get("failure_reason") or run.attrs.get("skip_reason")
+            raise ValueError(f"run {rid!r} is a {'failure' if is_failed(run) else 'skip'} marker ({reason}), but "
+                             f"{figure} draws that run itself; delete the file and rerun")
         sub = run[[v for v in keep if v in run]]
         for o in (*matrix.OUTPUTS, "Fz_mean"):
             sub[o] = run[o]
@@ -244,6 +249,11 @@ def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset]) -> 
                    {"units": "1", "long_name": "friction coefficient, MPM extrapolated to h -> 0"}),
         "mu_mpm_uncertainty": (("ball_diameter_mm", "mpm_load_N"), unc,
                                {"units": "1", "long_name": "uncertainty of the MPM friction coefficient"}),
+        "mu_mpm_flagged": (("ball_diameter_mm", "mpm_load_N"), fig21["mu_h0_flagged"].values.astype(np.int8),
+                           {"units": "1", "long_name": "MPM extrapolation flagged (least squares / two sizes)"}),
+        "mu_mpm_failed_finest": (("ball_diameter_mm", "mpm_load_N"), fig21["failed_finest"].values.astype(np.int8),
+                                 {"units": "1", "long_name": "finest run stopped unstable (mpm.finest_failure: "
+                                  "record): extrapolated from the two coarser sizes"}),
     }, coords=coords)
 
 

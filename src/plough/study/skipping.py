@@ -15,14 +15,17 @@ skipping that run is refused by the dataset builder.
 
 Default off (``null``): the faithful reproduction runs every size.
 
-**Failure markers.** A finest sweep run may also stop unstable (``plough.mpm.solver.SimulationError``:
+**Failure markers.** A finest sweep run may also stop unstable (``plough.mpm.solver.InstabilityError``:
 at h = 2.5 um a prow can grow until material leaves the grid, README *Status*). With
 ``mpm.finest_failure: record`` (the default) its result file is then a *failure marker* (no result
 variables; the solver's message, the run id and provenance as attributes) and the figure dataset
 extrapolates that point from the two coarser sizes, as for a skipped run, flagged ``failed_finest``.
-With ``stop`` the job fails and the workflow with it. Any other error (a refused scene, a bug)
-always fails the job, and a failure marker where the config does not allow one is refused by the
-dataset builder.
+With ``stop`` the job fails and the workflow with it. Any other error (a refused scene, a load
+the sphere cannot reach, lost contact, a bug) always fails the job, and a failure marker where the
+config does not allow one is refused by the dataset builder. A picture's finest run is never
+recorded: in config/config.yaml each is also a sweep point (the rigid-plastic one of Figs. 11-13,
+the zinc-coated steel one at 22 N of Figs. 14, 16-19 and 21-23, the zinc block at 22 N of Figs. 15,
+17, 18, 20 and 23), so its stop fails every figure that needs it.
 """
 
 from __future__ import annotations
