@@ -149,6 +149,29 @@ def _draws(figure: str, ds: xr.Dataset, tmp_path: Path) -> None:
     assert png.exists() and png.stat().st_size > 10_000
 
 
+def _with_marker(run_files, tmp_path: Path, rid: str, marker: xr.Dataset) -> dict:
+    """The run files with run ``rid`` replaced by ``marker`` (a skip or failure marker, atomically written)."""
+    paths = dict(run_files)
+    paths[rid] = tmp_path / f"{rid}.nc"
+    write_netcdf_atomic(marker, paths[rid])
+    return paths
+
+
+def _recording() -> dict:
+    """The smoke config with mpm.finest_failure: record (the smoke config itself stops)."""
+    config = copy.deepcopy(SMOKE)
+    config["mpm"]["finest_failure"] = "record"
+    return config
+
+
+def _zinc_block_lightest():
+    """The zinc block at the lowest load and the first ball: its loads, ball radius and finest run id."""
+    real = MPM["real_materials"]
+    loads = [float(x) for x in real["loads_N"]]
+    r1 = float(real["ball_radii_um"][0])
+    return loads, r1, matrix.run_id(matrix.real_point(real, "zinc_block", loads[0], r1), min(SIZES))
+
+
 def _check_extrapolation(ds, o, sel, sig, suffix="", noisy=False):
     f0 = limit(o, sig)
     per_size = ds[o + suffix].sel(sel)
@@ -458,14 +481,8 @@ def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_fil
     declared), every other point is untouched; the dataset passes the atomic writer and draws."""
     from plough.study import skipping
 
-    real = MPM["real_materials"]
-    loads = [float(x) for x in real["loads_N"]]
-    r1 = float(real["ball_radii_um"][0])
-    point = matrix.real_point(real, "zinc_block", loads[0], r1)
-    finest = matrix.run_id(point, min(SIZES))
-    paths = dict(run_files)
-    paths[finest] = tmp_path / f"{finest}.nc"
-    write_netcdf_atomic(skipping.skip_marker({"name": finest}, {}, 0.1, []), paths[finest])
+    loads, r1, finest = _zinc_block_lightest()
+    paths = _with_marker(run_files, tmp_path, finest, skipping.skip_marker({"name": finest}, {}, 0.1, []))
 
     with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
         build_dataset(SMOKE, "fig15", paths)  # skip_finest_tolerance null: a marker is a stale file
@@ -575,16 +592,10 @@ def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_file
     and at a coarser size."""
     from plough.study import skipping
 
-    real = MPM["real_materials"]
-    loads = [float(x) for x in real["loads_N"]]
-    r1 = float(real["ball_radii_um"][0])
-    point = matrix.real_point(real, "zinc_block", loads[0], r1)
-    finest = matrix.run_id(point, min(SIZES))
-    paths = dict(run_files)
-    paths[finest] = tmp_path / f"{finest}.nc"
-    write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
-    record = copy.deepcopy(SMOKE)
-    record["mpm"]["finest_failure"] = "record"
+    loads, r1, finest = _zinc_block_lightest()
+    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker({"name": finest}, finest, "unstable run",
+                                                                              []))
+    record = _recording()
     assert finest in matrix.failure_recordable_runs(record)
     ds = build_dataset(record, "fig15", paths)
     sel = {"material": "zinc_block", "load_N": loads[0]}
@@ -604,10 +615,10 @@ def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_file
 
     with pytest.raises(ValueError, match="is a failure marker .*unstable run.*mpm.finest_failure is stop"):
         build_dataset(SMOKE, "fig15", paths)  # the smoke config stops on a failed run
-    coarse = matrix.run_id(point, max(SIZES))
-    paths = dict(run_files)
-    paths[coarse] = tmp_path / f"{coarse}.nc"
-    write_netcdf_atomic(skipping.failure_marker({"name": coarse}, coarse, "unstable run", []), paths[coarse])
+    coarse = finest.replace(f"_h{matrix.fmt(min(SIZES))}", f"_h{matrix.fmt(max(SIZES))}")
+    assert coarse in run_files
+    paths = _with_marker(run_files, tmp_path, coarse, skipping.failure_marker({"name": coarse}, coarse, "unstable run",
+                                                                              []))
     with pytest.raises(ValueError, match=f"run '{coarse}' is a failure marker"):
         build_dataset(record, "fig15", paths)
 
@@ -622,14 +633,10 @@ def test_sweep_figure_rings_the_points_whose_finest_run_failed(run_files, tmp_pa
     from plough.figures import mpm as mpm_figures
     from plough.study import skipping
 
-    real = MPM["real_materials"]
-    point = matrix.real_point(real, "zinc_block", float(real["loads_N"][0]), float(real["ball_radii_um"][0]))
-    finest = matrix.run_id(point, min(SIZES))
-    paths = dict(run_files)
-    paths[finest] = tmp_path / f"{finest}.nc"
-    write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
-    record = copy.deepcopy(SMOKE)
-    record["mpm"]["finest_failure"] = "record"
+    _, _, finest = _zinc_block_lightest()
+    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker({"name": finest}, finest, "unstable run",
+                                                                              []))
+    record = _recording()
     for data, rings in ((build_dataset(record, "fig15", paths), 1), (build_dataset(record, "fig15", run_files), 0)):
         fig, ax = plt.subplots()
         mpm_figures._sweep_panel(ax, data, "dp", "")
@@ -649,17 +656,14 @@ def test_fig22_carries_and_draws_a_failed_finest_run_of_fig21(run_files, tmp_pat
     from plough.figures import analytical as analytical_figures
     from plough.study import skipping
 
-    record = copy.deepcopy(SMOKE)
-    record["mpm"]["finest_failure"] = "record"
+    record = _recording()
     real = MPM["real_materials"]
     loads = [float(x) for x in real["loads_N"]]
     r_last = float(real["ball_radii_um"][-1])
-    point = matrix.real_point(real, "coated", loads[-1], r_last)
-    finest = matrix.run_id(point, min(SIZES))
+    finest = matrix.run_id(matrix.real_point(real, "coated", loads[-1], r_last), min(SIZES))
     assert finest in matrix.failure_recordable_runs(record)
-    paths = dict(run_files)
-    paths[finest] = tmp_path / f"{finest}.nc"
-    write_netcdf_atomic(skipping.failure_marker({"name": finest}, finest, "unstable run", []), paths[finest])
+    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker({"name": finest}, finest, "unstable run",
+                                                                              []))
     ds = build_dataset(record, "fig22", paths)
     sel = {"ball_diameter_mm": 2 * r_last / 1000, "mpm_load_N": loads[-1]}
     assert int(ds["mu_mpm_failed_finest"].sum()) == 1 and int(ds["mu_mpm_failed_finest"].sel(sel)) == 1
@@ -683,9 +687,8 @@ def test_a_marker_at_a_pictures_run_is_refused_naming_it(run_files, tmp_path):
     from plough.study import skipping
 
     rid = matrix.figure_runs(SMOKE, "fig19")[0]
-    paths = dict(run_files)
-    paths[rid] = tmp_path / f"{rid}.nc"
-    write_netcdf_atomic(skipping.failure_marker({"name": rid}, rid, "a particle left the grid", []), paths[rid])
+    marker = skipping.failure_marker({"name": rid}, rid, "a particle left the grid", [])
+    paths = _with_marker(run_files, tmp_path, rid, marker)
     with pytest.raises(ValueError, match=f"run '{rid}' is a failure marker .*a particle left the grid.*fig19 draws"):
         build_dataset(SMOKE, "fig19", paths)
     write_netcdf_atomic(skipping.skip_marker({"name": rid}, {}, 0.1, ["a.nc"]), paths[rid])
