@@ -71,20 +71,18 @@ def zone_throughput_ratio(path: Path, k: float) -> float:
     return statistics.median(ratios)
 
 
-def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
+def add_measured_arguments(parser: argparse.ArgumentParser) -> None:
+    """The measured results files the throughput model reads (shared with projection_check.py)."""
     parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
     parser.add_argument("--graded-measured", default=str(ROOT / "benchmarks" / "results" / "graded_particles.json"))
     parser.add_argument("--zone-measured", default=str(ROOT / "benchmarks" / "results" / "active_zone.json"))
     parser.add_argument("--material-measured", default=str(ROOT / "benchmarks" / "results" / "material_cost.json"))
-    parser.add_argument("--bandwidth-measured",
-                        default=str(ROOT / "benchmarks" / "results" / "kernel_profile_zinc_coated_steel_h10.json"),
-                        help="kernel profile whose bytes per particle-step and triad bandwidth give the bound")
-    parser.add_argument("--target-h", type=float, default=4.0, help="wall-time target of the full reproduction, h")
-    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
-    args = parser.parse_args()
-    config = yaml.safe_load(Path(args.config).read_text())
+
+
+def throughput_model(config: dict, args: argparse.Namespace) -> tuple[float, float, float, float]:
+    """(rigid-plastic particle-steps per second, graded factor, active-zone factor, real-material factor):
+    the slowest reference run's throughput times the graded and zone factors the config's numerics call
+    for; a real-material run goes at the first value times the last."""
     measured = json.loads(Path(args.measured).read_text())
     throughput = min(r["particle_steps_per_s"] for r in measured["runs"])
     numerics = config["mpm"]["numerics"]
@@ -103,6 +101,27 @@ def main() -> None:
     material_factor = json.loads(Path(args.material_measured).read_text())["real_over_constant_throughput"]
     print(f"real materials: throughput x {material_factor:.3f} (real over constant flow stresses on the same block, "
           f"{args.material_measured})")
+    return throughput, graded_factor, zone_factor, material_factor
+
+
+def is_real_material(scene: Scene) -> bool:
+    """A run whose layers use the real materials' flow laws (not constant flow stresses)."""
+    return not all(isinstance(m.flow, ConstantFlow) for m in scene.layers.materials)
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
+    add_measured_arguments(parser)
+    parser.add_argument("--bandwidth-measured",
+                        default=str(ROOT / "benchmarks" / "results" / "kernel_profile_zinc_coated_steel_h10.json"),
+                        help="kernel profile whose bytes per particle-step and triad bandwidth give the bound")
+    parser.add_argument("--target-h", type=float, default=4.0, help="wall-time target of the full reproduction, h")
+    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
+    args = parser.parse_args()
+    config = yaml.safe_load(Path(args.config).read_text())
+    numerics = config["mpm"]["numerics"]
+    throughput, graded_factor, zone_factor, material_factor = throughput_model(config, args)
     by_size: dict[float, dict[str, float]] = {}
     with_skip = copy.deepcopy(config)
     with_skip["mpm"]["skip_finest_tolerance"] = 0.05
@@ -114,7 +133,7 @@ def main() -> None:
     for rid, scene_dict in matrix.all_runs(config).items():
         scene = Scene.from_dict(scene_dict)
         c = cost.estimate(scene)
-        real = not all(isinstance(m.flow, ConstantFlow) for m in scene.layers.materials)
+        real = is_real_material(scene)
         seconds = c.particle_steps / (throughput * (material_factor if real else 1.0))
         if rid in skippable:
             skippable_s += seconds

@@ -1,0 +1,84 @@
+"""The reproduction projection against a workflow run that was made: projected vs measured wall time per run.
+
+    python benchmarks/projection_check.py --workdir DIR [--config config/preview.yaml] [--out FILE]
+
+``DIR`` is the directory a ``snakemake --cores 2 --configfile=CONFIG`` ran in. For every MPM run of the
+config whose per-run benchmark file ``DIR/benchmarks/runs/<run>.tsv`` exists (Snakemake's ``benchmark:``,
+column ``s``: the job's wall time, numba's start-up included), the projection of
+``benchmarks/reproduction_time.py`` (particle-steps from ``plough.study.cost`` over the measured
+throughput, with the graded, active-zone and real-material factors) is set beside it. Prints the
+totals and the ratio measured / projected by particle size and family (median, range). Writes the
+per-run rows to ``--out`` (default benchmarks/results/projection_check.json).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import statistics
+from pathlib import Path
+
+import yaml
+from reproduction_time import ROOT, add_measured_arguments, is_real_material, throughput_model
+
+from plough.mpm.scene import Scene
+from plough.study import cost, matrix
+
+
+def measured_seconds(tsv: Path) -> float:
+    """The wall time in seconds of a Snakemake benchmark file (its first row, column ``s``)."""
+    with tsv.open() as f:
+        return float(next(csv.DictReader(f, delimiter="\t"))["s"])
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--workdir", type=Path, required=True, help="where the workflow ran")
+    parser.add_argument("--config", default=str(ROOT / "config" / "preview.yaml"))
+    add_measured_arguments(parser)
+    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "projection_check.json"))
+    args = parser.parse_args()
+    config = yaml.safe_load(Path(args.config).read_text())
+    throughput, _, _, material_factor = throughput_model(config, args)
+    rows = []
+    for rid, scene_dict in matrix.all_runs(config).items():
+        tsv = args.workdir / "benchmarks" / "runs" / f"{rid}.tsv"
+        if not tsv.exists():
+            continue
+        scene = Scene.from_dict(scene_dict)
+        c = cost.estimate(scene)
+        real = is_real_material(scene)
+        projected = c.particle_steps / (throughput * (material_factor if real else 1.0))
+        rows.append({"run": rid, "h_um": round(scene.discretisation.particle_size_m * 1e6, 6),
+                     "family": "real materials" if real else "rigid-plastic", "particles": c.particles,
+                     "particle_steps": c.particle_steps, "projected_s": projected,
+                     "measured_s": measured_seconds(tsv)})
+    if not rows:
+        raise SystemExit(f"no benchmark file of this config's runs under {args.workdir / 'benchmarks' / 'runs'}")
+    print(f"{len(rows)} of {len(matrix.all_runs(config))} runs measured\n")
+    print("| h (um) | family | runs | projected | measured | measured / projected: total, median (range) |")
+    print("|---|---|---|---|---|---|")
+    groups: dict[tuple[float, str], list[dict]] = {}
+    for r in rows:
+        groups.setdefault((r["h_um"], r["family"]), []).append(r)
+    groups[(0.0, "all")] = rows
+    summary = []
+    for (h, family), group in sorted(groups.items(), key=lambda kv: (-kv[0][0] if kv[0][0] else 1e9, kv[0][1])):
+        proj = sum(r["projected_s"] for r in group)
+        meas = sum(r["measured_s"] for r in group)
+        ratios = [r["measured_s"] / r["projected_s"] for r in group]
+        summary.append({"h_um": h or None, "family": family, "runs": len(group), "projected_s": proj,
+                        "measured_s": meas, "ratio_total": meas / proj, "ratio_median": statistics.median(ratios),
+                        "ratio_min": min(ratios), "ratio_max": max(ratios)})
+        label = f"{h:g}" if h else "all"
+        print(f"| {label} | {family} | {len(group)} | {proj / 60:.1f} min | {meas / 60:.1f} min | "
+              f"{meas / proj:.2f}, {statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")
+    Path(args.out).write_text(json.dumps({"config": args.config, "workdir": str(args.workdir),
+                                          "throughput_particle_steps_per_s": throughput,
+                                          "real_material_throughput_factor": material_factor,
+                                          "summary": summary, "runs": rows}, indent=2) + "\n")
+
+
+if __name__ == "__main__":
+    main()
