@@ -7,7 +7,7 @@ config whose per-run benchmark file ``DIR/benchmarks/runs/<run>.tsv`` exists (Sn
 column ``s``: the job's wall time, numba's start-up included), the projection of
 ``benchmarks/reproduction_time.py`` (particle-steps from ``plough.study.cost`` over the measured
 throughput, with the graded, active-zone and real-material factors) is set beside it. Prints the
-totals and the ratio measured / projected by particle size and family (median, range). Writes the
+totals and the ratio measured / projected by particle size, family and material system (median, range). Writes the
 per-run rows to ``--out`` (default benchmarks/results/projection_check.json).
 """
 
@@ -50,18 +50,24 @@ def main() -> None:
         c = cost.estimate(scene)
         real = is_real_material(scene)
         projected = c.particle_steps / (throughput * (material_factor if real else 1.0))
+        lay = scene.layers
+        system = ("rigid-plastic" if not real else lay.substrate.name if lay.coating is None
+                  else f"{lay.coating.name} on {lay.substrate.name}")
         rows.append({"run": rid, "h_um": round(scene.discretisation.particle_size_m * 1e6, 6),
-                     "family": "real materials" if real else "rigid-plastic", "particles": c.particles,
+                     "family": "real materials" if real else "rigid-plastic", "system": system,
+                     "particles": c.particles,
                      "particle_steps": c.particle_steps, "projected_s": projected,
                      "measured_s": measured_seconds(tsv)})
     if not rows:
         raise SystemExit(f"no benchmark file of this config's runs under {args.workdir / 'benchmarks' / 'runs'}")
     print(f"{len(rows)} of {len(matrix.all_runs(config))} runs measured\n")
-    print("| h (um) | family | runs | projected | measured | measured / projected: total, median (range) |")
+    print("| h (um) | family or material system | runs | projected | measured | measured / projected: total, "
+          "median (range) |")
     print("|---|---|---|---|---|---|")
     groups: dict[tuple[float, str], list[dict]] = {}
     for r in rows:
-        groups.setdefault((r["h_um"], r["family"]), []).append(r)
+        for label in {r["system"], r["family"]}:  # rigid-plastic is both
+            groups.setdefault((r["h_um"], label), []).append(r)
     groups[(0.0, "all")] = rows
     summary = []
     for (h, family), group in sorted(groups.items(), key=lambda kv: (-kv[0][0] if kv[0][0] else 1e9, kv[0][1])):
