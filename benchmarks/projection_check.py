@@ -16,9 +16,11 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
 import statistics
 from pathlib import Path
 
+import xarray as xr
 import yaml
 from reproduction_time import ROOT, add_measured_arguments, is_real_material, throughput_model
 
@@ -30,6 +32,15 @@ def measured_seconds(tsv: Path) -> float:
     """The wall time in seconds of a Snakemake benchmark file (its first row, column ``s``)."""
     with tsv.open() as f:
         return float(next(csv.DictReader(f, delimiter="\t"))["s"])
+
+
+def simulate_seconds(result: Path) -> float:
+    """The run's own wall time (``cost_wall_time_s``: press and slide, without the job's start-up and the
+    result's writing), NaN for a marker or a missing file."""
+    if not result.exists():
+        return float("nan")
+    with xr.open_dataset(result) as ds:
+        return float(ds.attrs.get("cost_wall_time_s", float("nan")))
 
 
 def main() -> None:
@@ -44,6 +55,7 @@ def main() -> None:
     rows = []
     for rid, scene_dict in matrix.all_runs(config).items():
         tsv = args.workdir / "benchmarks" / "runs" / f"{rid}.tsv"
+        result = args.workdir / "results" / "runs" / f"{rid}.nc"
         if not tsv.exists():
             continue
         scene = Scene.from_dict(scene_dict)
@@ -57,12 +69,12 @@ def main() -> None:
                      "family": "real materials" if real else "rigid-plastic", "system": system,
                      "particles": c.particles,
                      "particle_steps": c.particle_steps, "projected_s": projected,
-                     "measured_s": measured_seconds(tsv)})
+                     "measured_s": measured_seconds(tsv), "simulate_s": simulate_seconds(result)})
     if not rows:
         raise SystemExit(f"no benchmark file of this config's runs under {args.workdir / 'benchmarks' / 'runs'}")
     print(f"{len(rows)} of {len(matrix.all_runs(config))} runs measured\n")
-    print("| h (um) | family or material system | runs | projected | measured | measured / projected: total, "
-          "median (range) |")
+    print("| h (um) | family or material system | runs | projected | measured (job) | measured / projected: "
+          "total (simulation alone), median (range) |")
     print("|---|---|---|---|---|---|")
     groups: dict[tuple[float, str], list[dict]] = {}
     for r in rows:
@@ -74,12 +86,16 @@ def main() -> None:
         proj = sum(r["projected_s"] for r in group)
         meas = sum(r["measured_s"] for r in group)
         ratios = [r["measured_s"] / r["projected_s"] for r in group]
+        sim = sum(r["simulate_s"] for r in group if math.isfinite(r["simulate_s"]))
+        overhead = sum(r["measured_s"] - r["simulate_s"] for r in group if math.isfinite(r["simulate_s"]))
         summary.append({"h_um": h or None, "family": family, "runs": len(group), "projected_s": proj,
-                        "measured_s": meas, "ratio_total": meas / proj, "ratio_median": statistics.median(ratios),
-                        "ratio_min": min(ratios), "ratio_max": max(ratios)})
+                        "measured_s": meas, "simulate_s": sim, "job_overhead_s": overhead,
+                        "ratio_total": meas / proj, "ratio_simulate_total": sim / proj,
+                        "ratio_median": statistics.median(ratios), "ratio_min": min(ratios), "ratio_max": max(ratios)})
         label = f"{h:g}" if h else "all"
-        print(f"| {label} | {family} | {len(group)} | {proj / 60:.1f} min | {meas / 60:.1f} min | "
-              f"{meas / proj:.2f}, {statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")
+        print(f"| {label} | {family} | {len(group)} | {proj / 60:.1f} min | {meas / 60:.1f} min "
+              f"({overhead / 60:.1f} min start-up and writing) | {meas / proj:.2f} ({sim / proj:.2f} without), "
+              f"{statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")
     Path(args.out).write_text(json.dumps({"config": args.config, "workdir": str(args.workdir),
                                           "throughput_particle_steps_per_s": throughput,
                                           "real_material_throughput_factor": material_factor,
