@@ -210,6 +210,8 @@ def test_a_finest_run_that_stops_unstable_leaves_a_failure_marker(tmp_path, monk
                                               (record, picture, unstable), (record, finest, lost),
                                               (record, finest, ValueError("a refused scene"))]):
         (tmp_path / str(i)).mkdir()
+        stderr = sys.stderr
         with pytest.raises(type(error), match=re.escape(str(error))):
             _run_script(tmp_path / str(i), monkeypatch, config, rid, error)
         assert not list((tmp_path / str(i)).glob("*.nc")), (rid, error)
+        assert sys.stderr is stderr  # given back before the log closed: the traceback is not lost

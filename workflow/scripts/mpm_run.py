@@ -8,7 +8,7 @@ config's ``mpm.finest_failure`` is ``record`` (read here, not a param, so that c
 rerun the finest runs that succeeded).
 """
 
-import sys
+import contextlib
 
 import xarray as xr
 
@@ -39,8 +39,9 @@ def skipped(log) -> bool:
     return True
 
 
-with open(smk.log[0], "w", buffering=1) as log:
-    sys.stderr = log  # the progress bar (sliding distance, ETA, Fx/Fz) goes to logs/runs/<run>.log
+# the progress bar (sliding distance, ETA, Fx/Fz) goes to logs/runs/<run>.log; stderr is given back before the
+# log closes, so that a failing run's traceback reaches Snakemake's output (not "lost sys.stderr")
+with open(smk.log[0], "w", buffering=1) as log, contextlib.redirect_stderr(log):
     scene = Scene.from_dict(smk.params.scene)
     if not skipped(log):
         try:
