@@ -7,7 +7,7 @@ import os
 import numpy as np
 import xarray as xr
 
-from plough.figures.style import COLOURS, LABELS, caption, new_figure, save, shade_where
+from plough.figures.style import COLOURS, FAILED_FINEST_LABEL, LABELS, caption, new_figure, ring, save, shade_where
 
 FRICTION = ("mu", "mu_pl", "mu_sh")
 
@@ -101,8 +101,7 @@ def plot_fig22(ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
             if "mu_mpm_failed_finest" in ds:
                 stopped = ds["mu_mpm_failed_finest"].sel(ball_diameter_mm=d).values.astype(bool)
                 if stopped.any():
-                    ax.plot(x[stopped], mpm.values[stopped], ls="none", marker="o", ms=11, mfc="none", mec="k",
-                            mew=0.8, label="finest run stopped unstable: from the two coarser sizes")
+                    ring(ax, x[stopped], mpm.values[stopped], FAILED_FINEST_LABEL)
         ax.set_yscale("log")
         ax.set_xlabel("normal load Fn (N)")
         ax.set_ylabel("friction coefficient (-)")

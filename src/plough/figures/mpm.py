@@ -10,7 +10,7 @@ import numpy as np
 import xarray as xr
 from matplotlib.patches import Circle
 
-from plough.figures.style import caption, new_figure, save, shade_where
+from plough.figures.style import FAILED_FINEST_LABEL, caption, new_figure, ring, save, shade_where
 
 SERIES_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange"]
 SIZE_MARKERS = ["^", "s", "v", "D", "P"]
@@ -46,7 +46,7 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
     steady = ds.get(f"steady{suffix}")  # per run; absent for result files from before the check
     error = ds.get(f"{quantity}_standard_error{suffix}")  # per run (mu, mu_pl, mu_sh, dp); absent in old files
     unsteady_label = "run not steady (mu_drift or prow growth in its window)"
-    failed_label = "finest run stopped unstable: from the two coarser sizes"
+    failed_label = FAILED_FINEST_LABEL
     for i, label in enumerate(ds[series_dim].values):
         colour = SERIES_COLOURS[i % len(SERIES_COLOURS)]
         sel = {series_dim: label}
@@ -77,8 +77,7 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
         if failed is not None:
             stopped = failed.sel(sel).values.astype(bool)
             if stopped.any():
-                ax.plot(x[stopped], val[stopped], ls="none", marker="o", ms=11, mfc="none", mec="k", mew=0.8,
-                        label=failed_label)
+                ring(ax, x[stopped], val[stopped], failed_label)
                 failed_label = None
         ana = f"{quantity}_analytical{suffix}"
         if ana in ds:

@@ -43,6 +43,15 @@ def shade_where(ax, x, mask, label: str | None = None) -> None:
                     step="mid", label=label, zorder=0, linewidth=0)
 
 
+#: legend of the ring around an MPM point whose finest run stopped unstable (mpm.finest_failure: record)
+FAILED_FINEST_LABEL = "finest run stopped unstable: from the two coarser sizes"
+
+
+def ring(ax, x, y, label: str | None = None) -> None:
+    """A ring around the points (x, y): their finest run stopped unstable and two sizes stand in for it."""
+    ax.plot(x, y, ls="none", marker="o", ms=11, mfc="none", mec="k", mew=0.8, label=label)
+
+
 def save(fig: Figure, outputs: list[str | os.PathLike[str]]) -> None:
     """Save to each output (PNG, PDF...) atomically: temporary file, then rename."""
     for out in outputs:
