@@ -22,10 +22,10 @@ from pathlib import Path
 
 import xarray as xr
 import yaml
-from reproduction_time import ROOT, add_measured_arguments, is_real_material, throughput_model
+from reproduction_time import ROOT, add_measured_arguments, project_run, throughput_model
 
 from plough.mpm.scene import Scene
-from plough.study import cost, matrix
+from plough.study import matrix
 
 
 def measured_seconds(tsv: Path) -> float:
@@ -59,9 +59,7 @@ def main() -> None:
         if not tsv.exists():
             continue
         scene = Scene.from_dict(scene_dict)
-        c = cost.estimate(scene)
-        real = is_real_material(scene)
-        projected = c.particle_steps / (throughput * (material_factor if real else 1.0))
+        c, real, projected = project_run(scene, throughput, material_factor)
         lay = scene.layers
         system = ("rigid-plastic" if not real else lay.substrate.name if lay.coating is None
                   else f"{lay.coating.name} on {lay.substrate.name}")

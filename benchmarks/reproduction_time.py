@@ -109,6 +109,13 @@ def is_real_material(scene: Scene) -> bool:
     return not all(isinstance(m.flow, ConstantFlow) for m in scene.layers.materials)
 
 
+def project_run(scene: Scene, throughput: float, material_factor: float) -> tuple[cost.RunCost, bool, float]:
+    """(the run's counted cost, whether its materials are real, its projected wall time in s)."""
+    c = cost.estimate(scene)
+    real = is_real_material(scene)
+    return c, real, c.particle_steps / (throughput * (material_factor if real else 1.0))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", default=str(ROOT / "config" / "config.yaml"))
@@ -132,9 +139,7 @@ def main() -> None:
                  "real materials": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0}}
     for rid, scene_dict in matrix.all_runs(config).items():
         scene = Scene.from_dict(scene_dict)
-        c = cost.estimate(scene)
-        real = is_real_material(scene)
-        seconds = c.particle_steps / (throughput * (material_factor if real else 1.0))
+        c, real, seconds = project_run(scene, throughput, material_factor)
         if rid in skippable:
             skippable_s += seconds
             skippable_ps += c.particle_steps
