@@ -34,3 +34,25 @@ def test_flags_of_a_symmetric_grid():
     assert np.all(flags[(pos[:, 1] < -1e-12) & inside] == GHOST)
     outside = (pos[:, 1] ** 2 + pos[:, 2] ** 2 >= (170e-6) ** 2) & (pos[:, 2] < 0) & (pos[:, 1] > 1e-12)
     assert np.all(flags[outside] == FIXED)
+
+
+def test_a_taller_grid_keeps_every_node_where_it_was_and_its_data_with_it():
+    from plough.mpm.grid import extend_node_array, taller
+
+    g = make_grid(300e-6, 80e-6, True, 10e-6, 20e-6)
+    t = taller(g, 4)
+    nx, ny, nz = g.shape
+    assert t.shape == (nx, ny, nz + 4) and np.array_equal(t.origin, g.origin) and t.dx == g.dx
+    old_pos = g.node_positions().reshape(nx, ny, nz, 3)
+    assert np.array_equal(t.node_positions().reshape(nx, ny, nz + 4, 3)[:, :, :nz], old_pos)
+    data = np.arange(g.n_nodes * 2, dtype=float).reshape(g.n_nodes, 2)
+    new = extend_node_array(data, g.shape, 4, fill=-1.0).reshape(nx, ny, nz + 4, 2)
+    assert np.array_equal(new[:, :, :nz], data.reshape(nx, ny, nz, 2)) and np.all(new[:, :, nz:] == -1.0)
+    per_chunk = np.stack([data, 2 * data])  # (chunks, nodes, 2), nodes along axis 1
+    new = extend_node_array(per_chunk, g.shape, 4, axis=1, fill=0.0)
+    assert new.shape == (2, t.n_nodes, 2) and new.flags.c_contiguous
+    assert np.array_equal(new[1].reshape(nx, ny, nz + 4, 2)[:, :, :nz], 2 * data.reshape(nx, ny, nz, 2))
+    top = extend_node_array(np.arange(g.n_nodes), g.shape, 4).reshape(nx, ny, nz + 4)
+    assert np.array_equal(top[:, :, nz + 3], top[:, :, nz - 1])  # fill None: the old top layer again
+    with pytest.raises(ValueError, match="extra_cells = 0"):
+        taller(g, 0)

@@ -23,6 +23,7 @@ from plough import cli
 from plough.mpm import contact, io, solver, transfers
 from plough.mpm import run as run_module
 from plough.mpm import scene as scene_module
+from plough.mpm.grid import boundary_flags
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
@@ -243,18 +244,87 @@ def test_check_stability_names_step_sliding_distance_and_cause(tiny_state, code)
     solver.check_stability(state, const)
 
 
-def test_a_particle_above_the_grid_top_is_named_a_prow_and_points_at_the_headroom(tiny_state):
-    state, const = tiny_state
+def _flag_above_the_top(state, const, index=5, over_m=None):
+    """Mark particle ``index`` as having risen ``over_m`` (default a tenth of a cell) above the grid's top."""
     state.work.acc[:] = 0.0
     state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
-    state.work.acc[0, transfers.ACC_BAD_INDEX] = 5
-    state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * const.grid.dx
-    with pytest.raises(solver.InstabilityError, match=r"rose above the grid's top.*domain\.headroom_m"):
+    state.work.acc[0, transfers.ACC_BAD_INDEX] = index
+    state.particles.x[index, 2] = const.grid_hi[2] + (0.1 * const.grid.dx if over_m is None else over_m)
+
+
+def test_a_particle_above_a_hand_set_grid_top_is_named_a_prow_and_points_at_the_headroom(tiny_scene):
+    scene = tiny_scene.with_(domain=replace(tiny_scene.domain, headroom_m=tiny_scene.grid_headroom_m))
+    state, const = solver.init(scene, n_chunks=1)
+    assert const.grid_top_limit_m == 0.0  # the scene's own headroom is kept
+    _flag_above_the_top(state, const)
+    with pytest.raises(solver.InstabilityError, match=r"rose above the grid's top.*domain\.headroom_m") as err:
         solver.check_stability(state, const)
+    assert "stops at" not in str(err.value) and not state.grid_raises
     state.particles.x[5, 2] = 0.0  # left through a side: the general cause
     with pytest.raises(solver.SimulationError) as err:
         solver.check_stability(state, const)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "headroom" not in str(err.value)
+
+
+def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
+    """The room above the surface doubles, every node keeps its flags, and the run goes on."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    old_shape, old_top, old_flags = const.grid.shape, float(const.grid_hi[2]), state.work.flags.copy()
+    _flag_above_the_top(state, const)
+    solver.check_stability(state, const)  # no error
+    nx, ny, nz = const.grid.shape
+    assert (nx, ny) == old_shape[:2] and nz > old_shape[2]
+    assert 2.0 * old_top <= const.grid_hi[2] < 2.0 * old_top + const.grid.dx
+    assert const.grid_hi[2] == pytest.approx(const.grid.upper[2] - const.grid.dx, rel=1e-12)
+    assert state.zone.check_hi_m[2] == const.grid_hi[2] and list(const.shape) == [nx, ny, nz]
+    assert state.grid_raises == [(state.step, state.sphere.slid_m, float(const.grid_hi[2]))]
+    flags = state.work.flags.reshape(nx, ny, nz)
+    assert np.array_equal(flags[:, :, :old_shape[2]], old_flags.reshape(old_shape))
+    assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
+    for name in ("grid_m", "grid_div", "last_push"):
+        assert getattr(state.work, name).shape[0] == nx * ny * nz, name
+    assert state.work.grid_v.shape == (nx * ny * nz, 6) and state.work.grid_buf.shape[1] == nx * ny * nz
+    # another particle left through a side on the same step: the raise does not hide it
+    state2, const2 = solver.init(tiny_scene, n_chunks=1)
+    _flag_above_the_top(state2, const2)
+    state2.particles.x[9, 1] = const2.grid_hi[1] + const2.grid.dx
+    with pytest.raises(solver.InstabilityError, match="particle 9 ") as err:
+        solver.check_stability(state2, const2)
+    assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value)
+
+
+def test_the_automatic_grid_top_stops_at_the_spheres_top(tiny_scene):
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    assert const.grid_top_limit_m == pytest.approx(2.0 * tiny_scene.sphere.radius_m)
+    _flag_above_the_top(state, const, over_m=2.0 * tiny_scene.sphere.radius_m)
+    with pytest.raises(solver.InstabilityError, match=r"rose above the grid's top.*stops at 2 sphere radii, 400\.0 um"):
+        solver.check_stability(state, const)
+    assert not state.grid_raises
+
+
+def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_taller_grid(tiny_scene):
+    """Raised mid-slide (contact memory, grid buffers and the active zone in use) against raised at step 0,
+    which is the taller grid from the start (same flags as the taller grid's own): same particles, same forces."""
+    raised_late, c_late = solver.init(tiny_scene, n_chunks=1)
+    while not (raised_late.sphere.phase == "slide" and raised_late.sphere.slid_m >= 10e-6):
+        solver.step(raised_late, c_late)
+    assert solver.raise_grid_top(raised_late, c_late)
+    from_start, c_start = solver.init(tiny_scene, n_chunks=1)
+    assert solver.raise_grid_top(from_start, c_start)
+    assert np.array_equal(from_start.work.flags, boundary_flags(c_start.grid, tiny_scene.domain.radius_m, True))
+    assert c_start.grid.shape == c_late.grid.shape
+    for _ in range(raised_late.step + 150 - from_start.step):
+        solver.step(from_start, c_start)
+    for _ in range(150):
+        solver.step(raised_late, c_late)
+    assert from_start.step == raised_late.step and raised_late.sphere.slid_m > 10e-6
+    for name in ("x", "v", "stress", "eps_p", "J"):
+        np.testing.assert_allclose(getattr(raised_late.particles, name), getattr(from_start.particles, name),
+                                   rtol=1e-12, atol=1e-300, err_msg=name)
+    np.testing.assert_allclose(raised_late.sphere.centre, from_start.sphere.centre, rtol=1e-12)
+    np.testing.assert_allclose(raised_late.work.contact_out, from_start.work.contact_out, rtol=1e-10, atol=1e-18)
+    # and it moved: a raise that scrambled the contact memory or the grid would not match
+    assert np.abs(raised_late.particles.x - solver.init(tiny_scene, n_chunks=1)[0].particles.x).max() > 1e-7
 
 
 def test_grid_top_follows_the_headroom(tiny_scene):

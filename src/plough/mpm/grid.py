@@ -54,6 +54,29 @@ def make_grid(length_m: float, radius_m: float, symmetric: bool, dx: float, head
     return Grid(origin=lo, dx=dx, shape=shape)
 
 
+def taller(grid: Grid, extra_cells: int) -> Grid:
+    """The same grid with ``extra_cells`` more node layers on top: every existing node keeps its
+    (i, j, k) and its position, since the origin sits at the bottom."""
+    if extra_cells < 1:
+        raise ValueError(f"extra_cells = {extra_cells} must be >= 1")
+    nx, ny, nz = grid.shape
+    return Grid(origin=grid.origin, dx=grid.dx, shape=(nx, ny, nz + extra_cells))
+
+
+def extend_node_array(data: np.ndarray, shape: tuple[int, int, int], extra_cells: int, axis: int = 0,
+                      fill: float | None = None) -> np.ndarray:
+    """Node data of a grid of ``shape`` (flat nodes along ``axis``) laid out on the grid with
+    ``extra_cells`` more layers on top. The new layers hold ``fill``, or with ``fill`` None a copy of
+    the old top layer (for the boundary flags: above the surface they depend on y alone)."""
+    nx, ny, nz = shape
+    moved = np.moveaxis(data, axis, 0)
+    old = moved.reshape((nx, ny, nz) + moved.shape[1:])
+    new = np.empty((nx, ny, nz + extra_cells) + moved.shape[1:], dtype=data.dtype)
+    new[:, :, :nz] = old
+    new[:, :, nz:] = old[:, :, nz - 1:nz] if fill is None else fill
+    return np.ascontiguousarray(np.moveaxis(new.reshape((-1,) + moved.shape[1:]), 0, axis))
+
+
 def mirror_plane_index(grid: Grid, symmetric: bool) -> int:
     """Index j of the node plane y = 0 with symmetry, -1 without."""
     if not symmetric:

@@ -138,6 +138,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     stopper = SteadyStop(scene) if scene.sliding.stop_when_steady else None
     slid_distance = scene.sliding.distance_m
     active_particle_steps = 0
+    raises_told = 0
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
@@ -156,6 +157,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                 io.write_snapshot(state.particles, Path(snapshots_dir) / name, state.sphere.centre,
                                   const.sphere_radius, coating_row)
                 next_snap += snap_every
+            if bar is not None and len(state.grid_raises) > raises_told:
+                raises_told = len(state.grid_raises)
+                step_no, slid_m, top_m = state.grid_raises[-1]
+                bar.write(f"{scene.name}: material reached the grid's top at step {step_no} ({slid_m * 1e6:.1f} um "
+                          f"slid); the grid's top raised to {top_m * 1e6:.1f} um above the original surface")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)
     finally:
@@ -172,7 +178,8 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
             "dt_s": const.dt, "particle_steps": active_particle_steps,
             "active_fraction": active_particle_steps / max(n * state.step, 1),
-            "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads()}
+            "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads(),
+            "grid_top_m": float(const.grid_hi[2]), "grid_top_raises": len(state.grid_raises)}
     ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
                           rec.max_penetration, coating_row, slid_distance_m=slid_distance)
     warn_if_unsteady(ds, scene.name)
