@@ -174,8 +174,9 @@ class Domain:
 
     ``headroom_m`` is the height of the grid above the original surface, the room material has to
     rise into (pile-up, and the prow an adhesive interface pushes up the sphere's front); None
-    sizes it from the expected groove (``Scene.grid_headroom_m``). It costs grid nodes, not
-    particles.
+    sizes it from the expected groove (``Scene.grid_headroom_m``) and lets the solver raise it
+    mid-run where material reaches it (``solver.raise_grid_top``); a value set here is kept. It
+    costs grid nodes, not particles.
     """
 
     radius_m: float = 200e-6
@@ -513,9 +514,11 @@ class Scene:
     def grid_headroom_m(self) -> float:
         """Height of the grid above the original surface: ``domain.headroom_m``, or room for the
         pile-up of the expected groove, max(2 dp, 2 cells) + 0.5 dp (the grid adds 2-3 cells of
-        padding). A prow that keeps growing (f = 1 at h = 2.5 um, README *Status*) outgrows any
-        fixed rule; one expected contact radius more would cost 9-22% more grid nodes at h <= 5 um on
-        the reference scenes, so it is the knob's job."""
+        padding). A prow that keeps growing (f = 1 at h = 2.5 um, README *Status*; a soft coating
+        the sphere sweeps ahead) outgrows any fixed rule, and one expected contact radius more would
+        cost 9-22% more grid nodes at h <= 5 um on the reference scenes: with this automatic value
+        the solver raises the grid's top mid-run where material reaches it
+        (``solver.raise_grid_top``)."""
         if self.domain.headroom_m is not None:
             return self.domain.headroom_m
         _, dp = self.expected_contact()

@@ -20,6 +20,10 @@ With ``discretisation.active_zone_contact_radii`` the step works only on the par
 started within that many expected contact radii of the sphere's centre along x, and on the grid
 slabs around them (:class:`ActiveZone`): particles and nodes are stored x-major, so both are
 index ranges; the material beyond is frozen and clamps the active part.
+
+Material that rises past the grid's top (a prow that keeps growing) raises it mid-run where the
+scene leaves the headroom automatic (:func:`raise_grid_top`); any other particle leaving the grid,
+and a hand-set headroom, stop the run (:func:`check_stability`).
 """
 
 from __future__ import annotations
@@ -453,7 +457,8 @@ CAUSES = {
 
 
 def check_stability(s: State, c: Constants) -> None:
-    """Stop at once, naming the step, the sliding distance and the likely cause."""
+    """Stop at once, naming the step, the sliding distance and the likely cause; a particle past an
+    automatic grid top raises the top instead (:func:`raise_grid_top`) where that holds every particle."""
     acc = s.work.acc
     bad = int(acc[:, transfers.ACC_BAD].max())
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
