@@ -11,6 +11,7 @@ from __future__ import annotations
 import copy
 import json
 import math
+import warnings
 from dataclasses import replace
 
 import numba
@@ -302,29 +303,70 @@ def test_the_automatic_grid_top_stops_at_the_spheres_top(tiny_scene):
     assert not state.grid_raises
 
 
-def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_taller_grid(tiny_scene):
-    """Raised mid-slide (contact memory, grid buffers and the active zone in use) against raised at step 0,
-    which is the taller grid from the start (same flags as the taller grid's own): same particles, same forces."""
-    raised_late, c_late = solver.init(tiny_scene, n_chunks=1)
+def test_a_raise_that_doubling_would_carry_past_the_limit_stops_at_the_limit(tiny_scene):
+    """Room for the particle below the limit: the top goes to the limit (not refused because 2x passes it)."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    dx, top0 = const.grid.dx, float(const.grid_hi[2])
+    const.grid_top_limit_m = 1.5 * top0
+    _flag_above_the_top(state, const)
+    solver.check_stability(state, const)
+    assert const.grid_top_limit_m - dx < const.grid_hi[2] <= const.grid_top_limit_m + 1e-12
+    assert state.particles.x[5, 2] < const.grid_hi[2]
+    _flag_above_the_top(state, const)  # no room left: the run stops, naming the limit
+    with pytest.raises(solver.InstabilityError, match="automatic headroom stops at"):
+        solver.check_stability(state, const)
+    assert len(state.grid_raises) == 1
+
+
+@pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])
+def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_taller_grid(tiny_scene, zone):
+    """Raised mid-slide (contact memory and grid buffers in use) against raised at step 0, which is the
+    taller grid from the start (same flags as the taller grid's own): same particles, same forces."""
+    scene = tiny_scene.with_(discretisation=replace(tiny_scene.discretisation, active_zone_contact_radii=zone))
+    raised_late, c_late = solver.init(scene, n_chunks=1)
     while not (raised_late.sphere.phase == "slide" and raised_late.sphere.slid_m >= 10e-6):
         solver.step(raised_late, c_late)
     assert solver.raise_grid_top(raised_late, c_late)
-    from_start, c_start = solver.init(tiny_scene, n_chunks=1)
+    from_start, c_start = solver.init(scene, n_chunks=1)
     assert solver.raise_grid_top(from_start, c_start)
-    assert np.array_equal(from_start.work.flags, boundary_flags(c_start.grid, tiny_scene.domain.radius_m, True))
+    assert np.array_equal(from_start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
     assert c_start.grid.shape == c_late.grid.shape
     for _ in range(raised_late.step + 150 - from_start.step):
         solver.step(from_start, c_start)
     for _ in range(150):
         solver.step(raised_late, c_late)
     assert from_start.step == raised_late.step and raised_late.sphere.slid_m > 10e-6
+    assert (raised_late.zone.p_hi - raised_late.zone.p_lo < raised_late.particles.n) == (zone is not None)
     for name in ("x", "v", "stress", "eps_p", "J"):
         np.testing.assert_allclose(getattr(raised_late.particles, name), getattr(from_start.particles, name),
                                    rtol=1e-12, atol=1e-300, err_msg=name)
     np.testing.assert_allclose(raised_late.sphere.centre, from_start.sphere.centre, rtol=1e-12)
     np.testing.assert_allclose(raised_late.work.contact_out, from_start.work.contact_out, rtol=1e-10, atol=1e-18)
     # and it moved: a raise that scrambled the contact memory or the grid would not match
-    assert np.abs(raised_late.particles.x - solver.init(tiny_scene, n_chunks=1)[0].particles.x).max() > 1e-7
+    assert np.abs(raised_late.particles.x - solver.init(scene, n_chunks=1)[0].particles.x).max() > 1e-7
+
+
+def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatch, capsys):
+    assert tiny_run.attrs["cost_grid_top_raises"] == 0
+    _, const = solver.init(tiny_scene, n_chunks=1)
+    assert tiny_run.attrs["cost_grid_top_m"] == pytest.approx(const.grid_hi[2], rel=1e-12)
+    assert tiny_run.attrs["cost_grid_nodes"] == tiny_run.attrs["cost_grid_nodes_end"] == const.grid.n_nodes
+    real_step = solver.step
+
+    def step_raising_once(s, c):  # as check_stability would on a particle past the top
+        real_step(s, c)
+        if s.step == 40:
+            assert solver.raise_grid_top(s, c)
+
+    monkeypatch.setattr(solver, "step", step_raising_once)
+    short = tiny_scene.with_(sliding=replace(tiny_scene.sliding, distance_m=100e-6))
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", run_module.SteadyStateWarning)  # a short slide; not what is tested
+        ds = simulate(short, progress=True, threads=1)
+    assert ds.attrs["cost_grid_top_raises"] == 1
+    assert ds.attrs["cost_grid_top_m"] >= 2.0 * const.grid_hi[2]
+    assert ds.attrs["cost_grid_nodes_end"] > ds.attrs["cost_grid_nodes"] == const.grid.n_nodes
+    assert "material reached the grid's top at step 40" in capsys.readouterr().out
 
 
 def test_grid_top_follows_the_headroom(tiny_scene):

@@ -129,6 +129,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     wall0 = time.perf_counter()
     state, const = solver.init(scene)
     max_press_steps = int(10 * scene.sphere.radius_m / (const.press_speed * const.dt))
+    grid_nodes_start = const.grid.n_nodes  # the grid may grow (solver.raise_grid_top)
     rec = _Recorder(const.steps_slide / scene.outputs.records)
     n_snap = scene.outputs.snapshots
     snap_every = scene.sliding.distance_m / n_snap if n_snap else np.inf
@@ -175,7 +176,8 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     series, slid = rec.series()
     n = state.particles.n
     # particle-steps count the particles a step worked on (all of them without an active zone)
-    cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": const.grid.n_nodes,
+    cost = {"wall_time_s": wall, "steps": state.step, "particles": n, "grid_nodes": grid_nodes_start,
+            "grid_nodes_end": const.grid.n_nodes,
             "dt_s": const.dt, "particle_steps": active_particle_steps,
             "active_fraction": active_particle_steps / max(n * state.step, 1),
             "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads(),

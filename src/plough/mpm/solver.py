@@ -92,7 +92,8 @@ class SphereState:
 
 @dataclass
 class Constants:
-    """Everything a step needs that does not change during a run."""
+    """Everything a step needs that does not change during a run, but for the grid (``grid``, ``shape``,
+    ``grid_hi``) when its top is raised (:func:`raise_grid_top`)."""
 
     dt: float
     grid: Grid
@@ -497,8 +498,8 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``.
 
     The room above the surface at least doubles (a few raises cover any prow), one cell above the
-    highest particle at least. The origin is at the bottom, so every node keeps its (i, j, k) and
-    position: the per-node arrays are copied into the taller layout (new layers empty, contact
+    highest particle at least, and stops at the limit. The origin is at the bottom, so every node
+    keeps its (i, j, k) and position: the per-node arrays are copied into the taller layout (new layers empty, contact
     memory unpushed, flags those of the old top layer, as above the surface they depend on y alone)
     and the run goes on as if it had started on the taller grid. A particle past the old top on
     this step moved with a complete stencil on the old grid (it was inside before the move).
@@ -507,10 +508,13 @@ def raise_grid_top(s: State, c: Constants) -> bool:
         return False
     g, z, w = c.grid, s.zone, s.work
     top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
-    room = max(2.0 * c.grid_hi[2], top + g.dx)
-    if room > c.grid_top_limit_m:
+    now = float(c.grid_hi[2])
+    need = math.ceil((top + g.dx - now) / g.dx - 1e-9)  # cells added, each way
+    wanted = math.ceil((max(2.0 * now, top + g.dx) - now) / g.dx - 1e-9)
+    allowed = math.floor((c.grid_top_limit_m - now) / g.dx + 1e-9)
+    extra = min(wanted, allowed)
+    if extra < max(need, 1):
         return False
-    extra = int(math.ceil((room - c.grid_hi[2]) / g.dx - 1e-9))
     shape, new = g.shape, taller(g, extra)
     w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0)
     w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0)
