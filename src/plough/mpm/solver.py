@@ -499,9 +499,9 @@ def raise_grid_top(s: State, c: Constants) -> bool:
 
     The room above the surface at least doubles (a few raises cover any prow), one cell above the
     highest particle at least, and stops at the limit. The origin is at the bottom, so every node
-    keeps its (i, j, k) and position: the per-node arrays are copied into the taller layout (new layers empty, contact
-    memory unpushed, flags those of the old top layer, as above the surface they depend on y alone)
-    and the run goes on as if it had started on the taller grid. A particle past the old top on
+    keeps its (i, j, k) and position: the per-node arrays are copied into the taller layout (new
+    layers empty, contact memory unpushed, flags those of the old top layer, as above the surface
+    they depend on y alone) and the run goes on as if it had started on the taller grid. A particle past the old top on
     this step moved with a complete stencil on the old grid (it was inside before the move).
     """
     if c.grid_top_limit_m <= 0.0:
@@ -509,7 +509,8 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     g, z, w = c.grid, s.zone, s.work
     top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
     now = float(c.grid_hi[2])
-    need = math.ceil((top + g.dx - now) / g.dx - 1e-9)  # cells added, each way
+    # node layers to add: needed by the highest particle, wanted (the room doubled), allowed (the limit)
+    need = math.ceil((top + g.dx - now) / g.dx - 1e-9)
     wanted = math.ceil((max(2.0 * now, top + g.dx) - now) / g.dx - 1e-9)
     allowed = math.floor((c.grid_top_limit_m - now) / g.dx + 1e-9)
     extra = min(wanted, allowed)
