@@ -297,6 +297,33 @@ def test_fig11_has_two_panels_with_suffixed_variables(run_files, tmp_path):
     _draws("fig11", _written(ds, tmp_path), tmp_path)
 
 
+def test_thickness_panel_keeps_every_mark_in_view_and_the_legend_off_the_marks(run_files):
+    """Fig. 11b: a per-size dp far above the analytical lines and the dp = t line's reach stays in view (the
+    axis used to end at 1.3x the largest per-size value, hiding extrapolated marks above it); the t axis is
+    linear to THICKNESS_LINEAR_UM and logarithmic beyond, starting left of t = 0; the legend lies below the
+    axes, where it covers no mark."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from plough.figures import mpm as mpm_figures
+
+    ds = build_dataset(SMOKE, "fig11", run_files)
+    high = float(ds["dp_b"].max()) * 7.0  # an extrapolated mark far above every per-size value
+    ds["dp_h0_b"][{"coating": 0, "thickness_um": 1}] = high
+    fig, ax = plt.subplots()
+    mpm_figures._sweep_panel(ax, ds, "dp", "_b", thickness_axis=True)
+    lo, hi = ax.get_ylim()
+    marks = np.concatenate([ds["dp_b"].values.ravel(), ds["dp_h0_b"].values.ravel()]) * 1e6
+    assert lo == 0 and hi >= np.nanmax(marks) == pytest.approx(high * 1e6)
+    assert ax.get_xscale() == "symlog" and ax.get_xlim()[0] < 0 < ds["thickness_um"].values.max() < ax.get_xlim()[1]
+    fig.canvas.draw()
+    legend = ax.get_legend().get_window_extent()
+    assert legend.y1 <= ax.get_window_extent().y0  # entirely below the axes
+    plt.close(fig)
+
+
 def test_fig18_thickness_panel_and_bulk_panel(run_files, tmp_path):
     ds = build_dataset(SMOKE, "fig18", run_files)
     rts = MPM["real_materials"]["thickness_sweep"]

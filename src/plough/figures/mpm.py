@@ -14,6 +14,8 @@ from plough.figures.style import FAILED_FINEST_LABEL, caption, new_figure, ring,
 
 SERIES_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange"]
 SIZE_MARKERS = ["^", "s", "v", "D", "P"]
+#: the coating-thickness axis (Figs. 11b, 13b) is linear up to this thickness (um), logarithmic beyond
+THICKNESS_LINEAR_UM = 10.0
 QUANTITY = {"dp": ("ploughing depth dp (µm)", 1e6), "mu": ("friction coefficient mu (-)", 1.0),
             "penetration": ("penetration under load (µm)", 1e6)}
 FINDINGS = {
@@ -94,13 +96,25 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
             shade_where(ax, x, worn, label=f"coating wear (CW): MPM dp > t ({_label(ds[series_dim].values[0])})")
     if thickness_axis and quantity == "dp":
         ax.plot(x, x, color="0.5", ls=":", lw=1, label="dp = t")
-        ax.set_ylim(0, 1.3 * max(float(np.nanmax(per_size.values)) * scale, 1e-9))
+        # the dp = t line would stretch the axis to the bulk coating's 200 um: the top follows the marks
+        # (every per-size and extrapolated value stays in view; bars may leave it)
+        marks = np.concatenate([per_size.values.ravel(), ds[f"{quantity}_h0{suffix}"].values.ravel()]) * scale
+        ax.set_ylim(0, 1.15 * max(float(np.nanmax(marks)), 1e-9))
     if logx:
         ax.set_xscale("log")
+    if thickness_axis:  # linear over the thin coatings where dp crosses t, logarithmic out to the bulk coating
+        ax.set_xscale("symlog", linthresh=THICKNESS_LINEAR_UM)
+        ax.set_xlim(-0.05 * THICKNESS_LINEAR_UM, 1.3 * max(float(np.nanmax(x)), THICKNESS_LINEAR_UM))
+        ax.axvline(THICKNESS_LINEAR_UM, color="0.8", lw=0.6, zorder=0)
     ax.set_xlabel(ds[axis].attrs.get("long_name", axis) + (f" ({ds[axis].attrs['units']})"
                                                            if ds[axis].attrs.get("units", "1") != "1" else ""))
     ax.set_ylabel(name)
-    ax.legend(fontsize=6.5)
+    _legend_below(ax)
+
+
+def _legend_below(ax) -> None:
+    """The sweep panels' legend under the axes: inside them it covered marks."""
+    ax.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1, frameon=False)
 
 
 def _scene_note(ds: xr.Dataset) -> str:
@@ -113,7 +127,7 @@ def _scene_note(ds: xr.Dataset) -> str:
 
 
 def _fig11_13(ds: xr.Dataset, outputs, quantity: str, figure: str) -> None:
-    fig, axes = new_figure(1, 2, height_per_row=4.2)
+    fig, axes = new_figure(1, 2, height_per_row=5.6)
     t_a = float(ds.attrs.get("ratio_sweep_thickness_um", np.nan))
     _sweep_panel(axes[0, 0], ds, quantity, "_a", logx=True, thickness_um=t_a if np.isfinite(t_a) else None)
     axes[0, 0].set_title("(a) vs hardness ratio H~", fontsize=10)
@@ -133,7 +147,7 @@ def plot_fig13(ds: xr.Dataset, outputs) -> None:
 
 def _vs_load(quantity: str, figure: str):
     def plot(ds: xr.Dataset, outputs) -> None:
-        fig, axes = new_figure(1, 1, width=6.5, height_per_row=4.5)
+        fig, axes = new_figure(1, 1, width=6.5, height_per_row=5.8)
         _sweep_panel(axes[0, 0], ds, quantity, "")
         caption(fig, f"{ds.attrs['title']}. {_scene_note(ds)} {FINDINGS[figure]}")
         save(fig, outputs)
@@ -142,14 +156,14 @@ def _vs_load(quantity: str, figure: str):
 
 
 def plot_fig18(ds: xr.Dataset, outputs) -> None:
-    fig, axes = new_figure(1, 1, width=6.5, height_per_row=4.5)
+    fig, axes = new_figure(1, 1, width=6.5, height_per_row=5.8)
     ax = axes[0, 0]
     _sweep_panel(ax, ds, "dp", "_t")
     bulk = float(ds["dp_h0_bulk"].values.ravel()[0]) * 1e6
     unc = float(ds["dp_h0_uncertainty_bulk"].values.ravel()[0]) * 1e6
     ax.axhspan(bulk - unc, bulk + unc, color="0.85", zorder=0)
     ax.axhline(bulk, color="k", ls="--", label="MPM h -> 0, bulk zinc")
-    ax.legend(fontsize=6.5)
+    _legend_below(ax)
     caption(fig, f"{ds.attrs['title']}. {_scene_note(ds)} {FINDINGS['fig18']}")
     save(fig, outputs)
 
