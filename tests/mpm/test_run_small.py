@@ -318,6 +318,25 @@ def test_a_raise_that_doubling_would_carry_past_the_limit_stops_at_the_limit(tin
     assert len(state.grid_raises) == 1
 
 
+def test_a_raise_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(tiny_scene, monkeypatch):
+    """The raise counts what the run holds and what the taller grid adds against the physical memory: with
+    room for the run as it stands but not for the added layers it stops, nothing grown; with room, it raises."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    shape = const.grid.shape
+    held = solver._array_bytes(state.particles) + solver._array_bytes(state.work)
+    node = sum(a.nbytes for a in (state.work.grid_buf, state.work.grid_m, state.work.grid_v, state.work.grid_div,
+                                  state.work.cbuf, state.work.last_push, state.work.flags))
+    assert node < held  # the per-node arrays are part of what the run holds
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: held + node // shape[2])  # one more layer fits
+    _flag_above_the_top(state, const)
+    with pytest.raises(solver.InstabilityError, match=r"raising it by \d+ node layers would hold .* GiB, more than"):
+        solver.check_stability(state, const)
+    assert const.grid.shape == shape and not state.grid_raises and state.work.grid_m.size == np.prod(shape)
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: 10 * (held + node))
+    solver.check_stability(state, const)
+    assert const.grid.shape[2] > shape[2] and len(state.grid_raises) == 1
+
+
 @pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])
 def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_taller_grid(tiny_scene, zone):
     """Raised mid-slide (contact memory and grid buffers in use) against raised at step 0, which is the

@@ -516,6 +516,7 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     extra = min(wanted, allowed)
     if extra < max(need, 1):
         return False
+    check_raise_memory(s, g.shape, extra)
     shape, new = g.shape, taller(g, extra)
     w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0)
     w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0)
@@ -531,6 +532,29 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     z.check_hi_m[2] = c.grid_hi[2]
     s.grid_raises.append((s.step, s.sphere.slid_m, float(c.grid_hi[2])))
     return True
+
+
+def _array_bytes(obj: object) -> int:
+    return sum(v.nbytes for v in vars(obj).values() if isinstance(v, np.ndarray))
+
+
+def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available_bytes: int | None = None) -> None:
+    """Stop before a raise of the grid's top by ``extra`` node layers whose per-node arrays would not fit in
+    this machine's physical memory beside what the run already holds (``check_memory`` counted the particles
+    alone, before the grid could grow)."""
+    available = physical_memory_bytes() if available_bytes is None else available_bytes
+    if available is None:
+        return
+    node_bytes = sum(a.nbytes for a in (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div,
+                                        s.work.cbuf, s.work.last_push, s.work.flags))
+    added = node_bytes * extra // shape[2]
+    held = _array_bytes(s.particles) + _array_bytes(s.work)
+    if held + added > available:
+        raise InstabilityError(
+            f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material rose above "
+            f"the grid's top, and raising it by {extra} node layers would hold {(held + added) / 2**30:.3g} GiB, more "
+            f"than this machine's {available / 2**30:.3g} GiB of memory (a growing prow: coarser particles, a "
+            "smaller domain, or a hand-set domain.headroom_m to stop there)")
 
 
 def _outside_index(s: State) -> int:
