@@ -319,22 +319,34 @@ def test_a_raise_that_doubling_would_carry_past_the_limit_stops_at_the_limit(tin
 
 
 def test_a_raise_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(tiny_scene, monkeypatch):
-    """The raise counts what the run holds and what the taller grid adds against the physical memory: with
-    room for the run as it stands but not for the added layers it stops, nothing grown; with room, it raises."""
-    state, const = solver.init(tiny_scene, n_chunks=1)
+    """A raise counts the run's arrays and, at its peak, the new per-chunk P2G buffers beside the old ones or
+    the added layers: exactly enough memory passes, a byte less stops the run with nothing grown; where the
+    doubled room does not fit but the room the particle needs does, the top rises by that much."""
+    state, const = solver.init(tiny_scene, n_chunks=2)
     shape = const.grid.shape
     held = solver._array_bytes(state.particles) + solver._array_bytes(state.work)
-    node = sum(a.nbytes for a in (state.work.grid_buf, state.work.grid_m, state.work.grid_v, state.work.grid_div,
-                                  state.work.cbuf, state.work.last_push, state.work.flags))
-    assert node < held  # the per-node arrays are part of what the run holds
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: held + node // shape[2])  # one more layer fits
+    w = state.work
+    per_layer = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push,
+                                       w.flags)) // shape[2]
+    for extra in (1, 3, shape[2]):
+        peak = held + max(per_layer * extra, w.grid_buf.nbytes // shape[2] * (shape[2] + extra))
+        assert solver.raise_bytes(state, shape, extra) == peak
+        solver.check_raise_memory(state, shape, extra, available_bytes=peak)
+        with pytest.raises(solver.InstabilityError, match=rf"raising it by {extra} node layers would hold"):
+            solver.check_raise_memory(state, shape, extra, available_bytes=peak - 1)
+    # through check_stability: the particle, a tenth of a cell over the top, needs 2 layers (one cell of room
+    # above it); doubling wants more
     _flag_above_the_top(state, const)
-    with pytest.raises(solver.InstabilityError, match=r"raising it by \d+ node layers would hold .* GiB, more than"):
+    assert 2 < shape[2]
+    need = solver.raise_bytes(state, shape, 2)
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need - 1)
+    with pytest.raises(solver.InstabilityError, match=r"raising it by 2 node layers would hold .* GiB, more than"):
         solver.check_stability(state, const)
     assert const.grid.shape == shape and not state.grid_raises and state.work.grid_m.size == np.prod(shape)
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: 10 * (held + node))
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need)
     solver.check_stability(state, const)
-    assert const.grid.shape[2] > shape[2] and len(state.grid_raises) == 1
+    assert const.grid.shape[2] == shape[2] + 2 and len(state.grid_raises) == 1
+    assert state.particles.x[5, 2] < const.grid_hi[2]
 
 
 @pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])

@@ -312,15 +312,22 @@ def test_thickness_panel_keeps_every_mark_in_view_and_the_legend_off_the_marks(r
     ds = build_dataset(SMOKE, "fig11", run_files)
     high = float(ds["dp_b"].max()) * 7.0  # an extrapolated mark far above every per-size value
     ds["dp_h0_b"][{"coating": 0, "thickness_um": 1}] = high
-    fig, ax = plt.subplots()
+    ds["dp_h0_b"][{"coating": 1, "thickness_um": 1}] = -0.5 * high  # an extrapolation below zero
+    fig, ax = plt.subplots(layout="constrained")
     mpm_figures._sweep_panel(ax, ds, "dp", "_b", thickness_axis=True)
     lo, hi = ax.get_ylim()
-    marks = np.concatenate([ds["dp_b"].values.ravel(), ds["dp_h0_b"].values.ravel()]) * 1e6
-    assert lo == 0 and hi >= np.nanmax(marks) == pytest.approx(high * 1e6)
-    assert ax.get_xscale() == "symlog" and ax.get_xlim()[0] < 0 < ds["thickness_um"].values.max() < ax.get_xlim()[1]
+    assert lo <= -0.5 * high * 1e6 and hi >= high * 1e6
+    t = ds["thickness_um"].values
+    assert ax.get_xscale() == "symlog" and ax.get_xlim()[0] < 0 < t.max() < ax.get_xlim()[1]
+    assert set(ax.get_xticks()) >= {0.0, 10.0} and t.min() == 0
     fig.canvas.draw()
     legend = ax.get_legend().get_window_extent()
-    assert legend.y1 <= ax.get_window_extent().y0  # entirely below the axes
+    assert legend.y1 <= ax.xaxis.label.get_window_extent().y0  # below the axes and their label
+    plt.close(fig)
+    # thicknesses all past the linear range: no empty linear stretch at the left
+    fig, ax = plt.subplots()
+    mpm_figures._thickness_axis(ax, np.array([15.0, 30.0, 55.0]))
+    assert ax.get_xlim()[0] == pytest.approx(15.0 / 1.15) and list(ax.get_xticks()) == [20, 50]
     plt.close(fig)
 
 

@@ -9,6 +9,8 @@ import json
 import numpy as np
 import xarray as xr
 from matplotlib.patches import Circle
+from matplotlib.ticker import FixedFormatter, FixedLocator, NullLocator
+from matplotlib.transforms import offset_copy
 
 from plough.figures.style import FAILED_FINEST_LABEL, caption, new_figure, ring, save, shade_where
 
@@ -16,6 +18,7 @@ SERIES_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange"
 SIZE_MARKERS = ["^", "s", "v", "D", "P"]
 #: the coating-thickness axis (Figs. 11b, 13b) is linear up to this thickness (um), logarithmic beyond
 THICKNESS_LINEAR_UM = 10.0
+THICKNESS_TICKS_UM = (0, 2, 4, 6, 8, 10, 20, 50, 100, 200, 500, 1000)
 QUANTITY = {"dp": ("ploughing depth dp (µm)", 1e6), "mu": ("friction coefficient mu (-)", 1.0),
             "penetration": ("penetration under load (µm)", 1e6)}
 FINDINGS = {
@@ -96,25 +99,50 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
             shade_where(ax, x, worn, label=f"coating wear (CW): MPM dp > t ({_label(ds[series_dim].values[0])})")
     if thickness_axis and quantity == "dp":
         ax.plot(x, x, color="0.5", ls=":", lw=1, label="dp = t")
-        # the dp = t line would stretch the axis to the bulk coating's 200 um: the top follows the marks
-        # (every per-size and extrapolated value stays in view; bars may leave it)
-        marks = np.concatenate([per_size.values.ravel(), ds[f"{quantity}_h0{suffix}"].values.ravel()]) * scale
-        ax.set_ylim(0, 1.15 * max(float(np.nanmax(marks)), 1e-9))
+        # the dp = t line would stretch the axis to the bulk coating's 200 um: the axis follows the marks and
+        # the analytical lines (every per-size and extrapolated value in view, a negative extrapolation too;
+        # bars may leave it)
+        values = [per_size.values, ds[f"{quantity}_h0{suffix}"].values]
+        if f"{quantity}_analytical{suffix}" in ds:
+            values.append(ds[f"{quantity}_analytical{suffix}"].values)
+        marks = np.concatenate([v.ravel() for v in values]) * scale
+        marks = marks[np.isfinite(marks)]
+        if marks.size:
+            ax.set_ylim(min(0.0, 1.15 * float(marks.min())), 1.15 * max(float(marks.max()), 1e-9))
     if logx:
         ax.set_xscale("log")
     if thickness_axis:  # linear over the thin coatings where dp crosses t, logarithmic out to the bulk coating
-        ax.set_xscale("symlog", linthresh=THICKNESS_LINEAR_UM)
-        ax.set_xlim(-0.05 * THICKNESS_LINEAR_UM, 1.3 * max(float(np.nanmax(x)), THICKNESS_LINEAR_UM))
-        ax.axvline(THICKNESS_LINEAR_UM, color="0.8", lw=0.6, zorder=0)
+        _thickness_axis(ax, x)
     ax.set_xlabel(ds[axis].attrs.get("long_name", axis) + (f" ({ds[axis].attrs['units']})"
                                                            if ds[axis].attrs.get("units", "1") != "1" else ""))
     ax.set_ylabel(name)
     _legend_below(ax)
 
 
+def _thickness_axis(ax, x: np.ndarray) -> None:
+    """Symlog thickness axis: linear up to THICKNESS_LINEAR_UM, ticks where the thin coatings are."""
+    ax.set_xscale("symlog", linthresh=THICKNESS_LINEAR_UM)
+    lo, hi = float(np.nanmin(x)), max(float(np.nanmax(x)), THICKNESS_LINEAR_UM)
+    left = -0.05 * THICKNESS_LINEAR_UM if lo < THICKNESS_LINEAR_UM else lo / 1.15
+    ax.set_xlim(left, 1.3 * hi)
+    ticks = [t for t in THICKNESS_TICKS_UM if left <= t <= 1.3 * hi]
+    ax.xaxis.set_major_locator(FixedLocator(ticks))
+    ax.xaxis.set_major_formatter(FixedFormatter([f"{t:g}" for t in ticks]))
+    ax.xaxis.set_minor_locator(NullLocator())
+    if lo < THICKNESS_LINEAR_UM:
+        ax.axvline(THICKNESS_LINEAR_UM, color="0.8", lw=0.6, zorder=0)
+
+
+#: points between the axes' bottom and the legend's top: below the tick labels and the axis label
+LEGEND_DROP_PT = 34.0
+
+
 def _legend_below(ax) -> None:
-    """The sweep panels' legend under the axes: inside them it covered marks."""
-    ax.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=1, frameon=False)
+    """The sweep panels' legend under the axes and their label (inside the axes it covered marks); the gap
+    is in points, so that it clears the label whatever the panel's height."""
+    below = offset_copy(ax.transAxes, fig=ax.figure, y=-LEGEND_DROP_PT, units="points")
+    ax.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, ncol=1,
+              frameon=False)
 
 
 def _scene_note(ds: xr.Dataset) -> str:

@@ -69,12 +69,17 @@ def extend_node_array(data: np.ndarray, shape: tuple[int, int, int], extra_cells
     ``extra_cells`` more layers on top. The new layers hold ``fill``, or with ``fill`` None a copy of
     the old top layer (for the boundary flags: above the surface they depend on y alone)."""
     nx, ny, nz = shape
-    moved = np.moveaxis(data, axis, 0)
-    old = moved.reshape((nx, ny, nz) + moved.shape[1:])
-    new = np.empty((nx, ny, nz + extra_cells) + moved.shape[1:], dtype=data.dtype)
-    new[:, :, :nz] = old
-    new[:, :, nz:] = old[:, :, nz - 1:nz] if fill is None else fill
-    return np.ascontiguousarray(np.moveaxis(new.reshape((-1,) + moved.shape[1:]), 0, axis))
+    data = np.ascontiguousarray(data)
+    pre, post = data.shape[:axis], data.shape[axis + 1:]
+    # one allocation in the final layout (a copy through a moved axis held the new array twice: the
+    # per-chunk P2G buffers are most of a run's node memory)
+    out = np.empty(pre + (nx * ny * (nz + extra_cells),) + post, dtype=data.dtype)
+    old = data.reshape(pre + (nx, ny, nz) + post)
+    new = out.reshape(pre + (nx, ny, nz + extra_cells) + post)
+    k = (slice(None),) * (len(pre) + 2)  # up to the z axis of the node index
+    new[k + (slice(0, nz),)] = old
+    new[k + (slice(nz, None),)] = old[k + (slice(nz - 1, nz),)] if fill is None else fill
+    return out
 
 
 def mirror_plane_index(grid: Grid, symmetric: bool) -> int:

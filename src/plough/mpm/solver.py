@@ -459,7 +459,8 @@ CAUSES = {
 
 def check_stability(s: State, c: Constants) -> None:
     """Stop at once, naming the step, the sliding distance and the likely cause; a particle past an
-    automatic grid top raises the top instead (:func:`raise_grid_top`) where that holds every particle."""
+    automatic grid top raises the top instead (:func:`raise_grid_top`) where that holds every particle
+    and fits in memory."""
     acc = s.work.acc
     bad = int(acc[:, transfers.ACC_BAD].max())
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
@@ -495,10 +496,12 @@ def check_stability(s: State, c: Constants) -> None:
 
 def raise_grid_top(s: State, c: Constants) -> bool:
     """Raise the grid's top mid-run so that every active particle has room again; False where the
-    scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``.
+    scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``; stops the run
+    (:func:`check_raise_memory`) where even the room the particles need would not fit in memory.
 
-    The room above the surface at least doubles (a few raises cover any prow), one cell above the
-    highest particle at least, and stops at the limit. The origin is at the bottom, so every node
+    The room above the surface at least doubles (a few raises cover any prow; only the room needed
+    where the doubled one would not fit in memory), one cell above the highest particle at least,
+    and stops at the limit. The origin is at the bottom, so every node
     keeps its (i, j, k) and position: the per-node arrays are copied into the taller layout (new
     layers empty, contact memory unpushed, flags those of the old top layer, as above the surface
     they depend on y alone) and the run goes on as if it had started on the taller grid. A particle past the old top on
@@ -516,6 +519,8 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     extra = min(wanted, allowed)
     if extra < max(need, 1):
         return False
+    if raise_bytes(s, g.shape, extra) > _memory_or_inf() and extra > max(need, 1):
+        extra = max(need, 1)  # the doubled room does not fit in memory: the room the particles need
     check_raise_memory(s, g.shape, extra)
     shape, new = g.shape, taller(g, extra)
     w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0)
@@ -538,22 +543,35 @@ def _array_bytes(obj: object) -> int:
     return sum(v.nbytes for v in vars(obj).values() if isinstance(v, np.ndarray))
 
 
+def raise_bytes(s: State, shape: tuple[int, int, int], extra: int) -> int:
+    """Bytes the run holds at the peak of a raise of the grid's top by ``extra`` node layers: its particle
+    and per-node arrays, plus the layers added, or the new per-chunk P2G buffers while the old ones are still
+    held (most of a run's node memory), whichever is more."""
+    node_arrays = (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div, s.work.cbuf,
+                   s.work.last_push, s.work.flags)
+    added = sum(a.nbytes for a in node_arrays) * extra // shape[2]  # x-major nodes: nx ny extra more of nx ny nz
+    new_buffers = s.work.grid_buf.nbytes * (shape[2] + extra) // shape[2]
+    return _array_bytes(s.particles) + _array_bytes(s.work) + max(added, new_buffers)
+
+
+def _memory_or_inf() -> float:
+    available = physical_memory_bytes()
+    return float("inf") if available is None else float(available)
+
+
 def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available_bytes: int | None = None) -> None:
-    """Stop before a raise of the grid's top by ``extra`` node layers whose per-node arrays would not fit in
-    this machine's physical memory beside what the run already holds (``check_memory`` counted the particles
-    alone, before the grid could grow)."""
+    """Stop before a raise of the grid's top by ``extra`` node layers that would not fit in this machine's
+    physical memory (:func:`raise_bytes`; ``check_memory`` counted the particles alone, before the grid
+    could grow). The whole machine's memory: jobs beside the run are not counted."""
     available = physical_memory_bytes() if available_bytes is None else available_bytes
     if available is None:
         return
-    node_bytes = sum(a.nbytes for a in (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div,
-                                        s.work.cbuf, s.work.last_push, s.work.flags))
-    added = node_bytes * extra // shape[2]
-    held = _array_bytes(s.particles) + _array_bytes(s.work)
-    if held + added > available:
+    peak = raise_bytes(s, shape, extra)
+    if peak > available:
         raise InstabilityError(
             f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material rose above "
-            f"the grid's top, and raising it by {extra} node layers would hold {(held + added) / 2**30:.3g} GiB, more "
-            f"than this machine's {available / 2**30:.3g} GiB of memory (a growing prow: coarser particles, a "
+            f"the grid's top, and raising it by {extra} node layers would hold {peak / 2**30:.3g} GiB, more than "
+            f"this machine's {available / 2**30:.3g} GiB of memory (a growing prow: coarser particles, a "
             "smaller domain, or a hand-set domain.headroom_m to stop there)")
 
 
