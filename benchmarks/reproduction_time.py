@@ -20,6 +20,11 @@ Runs whose layers use the real materials' flow laws (hardening, rate terms, heat
 go at the real-materials' share of the constant-flow throughput measured on the same block
 (benchmarks/results/material_cost.json, ``benchmarks/material_cost.py``); the rigid-plastic runs
 at the reference throughput.
+With ``--calibration FILE ...`` (``benchmarks/projection_check.py`` results: workflow runs that were made,
+their job wall times beside the projection) the projection is also scaled per family (rigid-plastic, real
+materials) by measured / projected over that family's measured runs at the particle size nearest in
+log h (job time, start-up and writing included; the projection recomputed with today's throughput model
+from each run's particle-steps): the calibrated total says what the measured runs say of the rest.
 Last, the floor no code can beat on this machine: the particle-steps of the matrix (all, and with
 every skippable finest run skipped) at the memory-bandwidth bound of a step (bytes a particle-step
 moves, from a kernel profile, over the triad bandwidth: benchmarks/kernel_profile.py), and the
@@ -32,6 +37,7 @@ from __future__ import annotations
 import argparse
 import copy
 import json
+import math
 import statistics
 from pathlib import Path
 
@@ -104,6 +110,35 @@ def throughput_model(config: dict, args: argparse.Namespace) -> tuple[float, flo
     return throughput, graded_factor, zone_factor, material_factor
 
 
+def calibration_ratios(paths: list[str], throughput: float, material_factor: float
+                       ) -> dict[str, dict[float, tuple[int, float]]]:
+    """family -> h (um) -> (runs, sum of measured job seconds / sum of projected seconds) over the
+    ``projection_check.py`` files' rows (a run in several files counts once, its last measurement)."""
+    rows: dict[str, dict] = {}
+    for path in paths:
+        for r in json.loads(Path(path).read_text())["runs"]:
+            rows[r["run"]] = r
+    sums: dict[str, dict[float, list[float]]] = {}
+    for r in rows.values():
+        rate = throughput * (material_factor if r["family"] == "real materials" else 1.0)
+        acc = sums.setdefault(r["family"], {}).setdefault(float(r["h_um"]), [0, 0.0, 0.0])
+        acc[0] += 1
+        acc[1] += r["measured_s"]
+        acc[2] += r["particle_steps"] / rate
+    return {fam: {h: (int(a[0]), a[1] / a[2]) for h, a in by_h.items()} for fam, by_h in sums.items()}
+
+
+def calibration_for(ratios: dict[str, dict[float, tuple[int, float]]], family: str, h_um: float
+                    ) -> tuple[float, float] | None:
+    """(the measured size used, its ratio) for a run of ``family`` at ``h_um``: the size nearest in log h;
+    None where the family has no measured run."""
+    by_h = ratios.get(family)
+    if not by_h:
+        return None
+    nearest = min(by_h, key=lambda h: (abs(math.log(h / h_um)), h))
+    return nearest, by_h[nearest][1]
+
+
 def is_real_material(scene: Scene) -> bool:
     """A run whose layers use the real materials' flow laws (not constant flow stresses)."""
     return not all(isinstance(m.flow, ConstantFlow) for m in scene.layers.materials)
@@ -124,6 +159,8 @@ def main() -> None:
                         default=str(ROOT / "benchmarks" / "results" / "kernel_profile_zinc_coated_steel_h10.json"),
                         help="kernel profile whose bytes per particle-step and triad bandwidth give the bound")
     parser.add_argument("--target-h", type=float, default=4.0, help="wall-time target of the full reproduction, h")
+    parser.add_argument("--calibration", nargs="*", default=[],
+                        help="projection_check.py results whose measured runs scale the projection per family")
     parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "reproduction_time.json"))
     args = parser.parse_args()
     config = yaml.safe_load(Path(args.config).read_text())
@@ -135,14 +172,23 @@ def main() -> None:
     skippable = matrix.skippable_runs(with_skip)
     skippable_s = 0.0
     skippable_ps = 0.0
+    ratios = calibration_ratios(args.calibration, throughput, material_factor) if args.calibration else {}
+    calibrated: dict[str, float] = {}  # family -> calibrated seconds
+    calibrated_skippable_s = 0.0
     by_family = {"rigid-plastic": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0},
                  "real materials": {"runs": 0, "particle_steps": 0.0, "projected_s": 0.0}}
     for rid, scene_dict in matrix.all_runs(config).items():
         scene = Scene.from_dict(scene_dict)
         c, real, seconds = project_run(scene, throughput, material_factor)
+        family = "real materials" if real else "rigid-plastic"
+        h_um = scene.discretisation.particle_size_m * 1e6
+        used = calibration_for(ratios, family, h_um) if ratios else None
+        scaled = seconds * (used[1] if used else 1.0)
+        calibrated[family] = calibrated.get(family, 0.0) + scaled
         if rid in skippable:
             skippable_s += seconds
             skippable_ps += c.particle_steps
+            calibrated_skippable_s += scaled
         h = round(scene.discretisation.particle_size_m * 1e6, 6)
         row = by_size.setdefault(h, {"runs": 0, "particle_steps": 0.0, "largest_run_particles": 0, "projected_s": 0.0})
         row["runs"] += 1
@@ -169,6 +215,22 @@ def main() -> None:
     for name, fam in by_family.items():
         print(f"{name}: {fam['runs']} runs, {fam['particle_steps']:.3g} particle-steps, "
               f"{fam['projected_s'] / 3600:.1f} h")
+    calibration = None
+    if ratios:
+        cal_total = sum(calibrated.values())
+        print("\ncalibrated by the measured workflow runs (measured / projected, job time, by family and size):")
+        for fam, by_h in sorted(ratios.items()):
+            print(f"  {fam}: " + ", ".join(f"h = {h:g} um {r:.2f} ({n} runs)" for h, (n, r) in sorted(by_h.items())))
+        for fam, sec in sorted(calibrated.items()):
+            print(f"  {fam}: {sec / 3600:.1f} h calibrated")
+        print(f"calibrated total: {cal_total / 3600:.1f} h ({cal_total / 86400:.1f} days); lower bound with every "
+              f"skippable finest run skipped {(cal_total - calibrated_skippable_s) / 3600:.1f} h")
+        calibration = {"files": args.calibration,
+                       "ratios": {fam: {f"{h:g}": {"runs": n, "measured_over_projected": r}
+                                        for h, (n, r) in sorted(by_h.items())} for fam, by_h in ratios.items()},
+                       "rule": "each run scaled by its family's ratio at the measured size nearest in log h",
+                       "by_family_s": calibrated, "total_s": cal_total,
+                       "lower_bound_all_skipped_s": cal_total - calibrated_skippable_s}
     bound = json.loads(Path(args.bandwidth_measured).read_text())["bandwidth_bound_particle_steps_per_s"]
     target_s = args.target_h * 3600.0
     all_ps = sum(r["particle_steps"] for r in by_size.values())
@@ -188,7 +250,7 @@ def main() -> None:
            "total_projected_s": total, "skippable_runs": len(skippable),
            "lower_bound_all_skipped_s": total - skippable_s,
            "bandwidth_bound_particle_steps_per_s": bound, "bandwidth_measured": args.bandwidth_measured,
-           "target_s": target_s, "floor": floor}
+           "target_s": target_s, "floor": floor, "calibrated": calibration}
     Path(args.out).write_text(json.dumps(out, indent=2) + "\n")
 
 
