@@ -267,6 +267,24 @@ def test_a_particle_above_a_hand_set_grid_top_is_named_a_prow_and_points_at_the_
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "headroom" not in str(err.value)
 
 
+def test_a_particle_past_the_blocks_far_end_is_named_material_pushed_ahead(tiny_scene):
+    """Leaving through the far end (the soft coating's chip of the H~ = 0.25 run at h = 5 um) names the block's
+    length and how far ahead of the sphere; leaving through the near end keeps the general cause."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    state.work.acc[:] = 0.0
+    state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
+    state.work.acc[0, transfers.ACC_BAD_INDEX] = 7
+    state.particles.x[7, 0] = const.grid_hi[0] + 0.2 * const.grid.dx
+    ahead = (state.particles.x[7, 0] - state.sphere.centre[0]) * 1e6
+    with pytest.raises(solver.InstabilityError, match=rf"past the block's far end .* {ahead:.1f} um ahead of the "
+                                                      r"sphere's centre.*domain\.length_m"):
+        solver.check_stability(state, const)
+    state.particles.x[7, 0] = const.grid_lo[0] - 0.2 * const.grid.dx
+    with pytest.raises(solver.InstabilityError) as err:
+        solver.check_stability(state, const)
+    assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "far end" not in str(err.value)
+
+
 def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     """The room above the surface doubles, every node keeps its flags, and the run goes on."""
     state, const = solver.init(tiny_scene, n_chunks=1)

@@ -479,6 +479,12 @@ def check_stability(s: State, c: Constants) -> None:
             cause = (f"a particle rose above the grid's top (z = {c.grid_hi[2] * 1e6:.1f} um over the original "
                      "surface): material the sphere pushes up (a growing prow: set domain.headroom_m higher) or a "
                      f"particle flung off the surface (lower mass_scaling or speed){limit}")
+        elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 0] > c.grid_hi[0]:
+            ahead = (s.particles.x[index, 0] - s.sphere.centre[0]) * 1e6
+            cause = (f"a particle moved past the block's far end (x = {c.grid_hi[0] * 1e6:.1f} um), {ahead:.1f} um "
+                     "ahead of the sphere's centre: material the sphere pushes ahead of it (a prow or chip of a soft "
+                     "coating: lengthen domain.length_m) or a particle flung off the surface (lower mass_scaling or "
+                     "speed)")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
             zone = s.zone
             cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo_m[0] * 1e6:.1f}.."
