@@ -349,9 +349,9 @@ def test_a_raise_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(ti
     for extra in (1, 3, shape[2]):
         peak = held + max(per_layer * extra, w.grid_buf.nbytes // shape[2] * (shape[2] + extra))
         assert solver.raise_bytes(state, shape, extra) == peak
-        solver.check_raise_memory(state, shape, extra, available_bytes=peak)
+        solver.check_raise_memory(state, shape, extra, peak)
         with pytest.raises(solver.InstabilityError, match=rf"raising it by {extra} node layers would hold"):
-            solver.check_raise_memory(state, shape, extra, available_bytes=peak - 1)
+            solver.check_raise_memory(state, shape, extra, peak - 1)
     # through check_stability: the particle, a tenth of a cell over the top, needs 2 layers (one cell of room
     # above it); doubling wants more
     _flag_above_the_top(state, const)

@@ -525,9 +525,10 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     extra = min(wanted, allowed)
     if extra < max(need, 1):
         return False
-    if raise_bytes(s, g.shape, extra) > _memory_or_inf() and extra > max(need, 1):
+    available = physical_memory_bytes()
+    if available is not None and raise_bytes(s, g.shape, extra) > available and extra > max(need, 1):
         extra = max(need, 1)  # the doubled room does not fit in memory: the room the particles need
-    check_raise_memory(s, g.shape, extra)
+    check_raise_memory(s, g.shape, extra, available)
     shape, new = g.shape, taller(g, extra)
     w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0)
     w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0)
@@ -560,16 +561,11 @@ def raise_bytes(s: State, shape: tuple[int, int, int], extra: int) -> int:
     return _array_bytes(s.particles) + _array_bytes(s.work) + max(added, new_buffers)
 
 
-def _memory_or_inf() -> float:
-    available = physical_memory_bytes()
-    return float("inf") if available is None else float(available)
-
-
-def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available_bytes: int | None = None) -> None:
-    """Stop before a raise of the grid's top by ``extra`` node layers that would not fit in this machine's
-    physical memory (:func:`raise_bytes`; ``check_memory`` counted the particles alone, before the grid
-    could grow). The whole machine's memory: jobs beside the run are not counted."""
-    available = physical_memory_bytes() if available_bytes is None else available_bytes
+def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None) -> None:
+    """Stop before a raise of the grid's top by ``extra`` node layers that would not fit in ``available``
+    bytes, this machine's physical memory (:func:`raise_bytes`; ``check_memory`` counted the particles
+    alone, before the grid could grow); None: not known, no check. The whole machine's memory: jobs beside
+    the run are not counted."""
     if available is None:
         return
     peak = raise_bytes(s, shape, extra)
