@@ -128,15 +128,13 @@ def calibration_ratios(paths: list[str], throughput: float, material_factor: flo
     return {fam: {h: (int(a[0]), a[1] / a[2]) for h, a in by_h.items()} for fam, by_h in sums.items()}
 
 
-def calibration_for(ratios: dict[str, dict[float, tuple[int, float]]], family: str, h_um: float
-                    ) -> tuple[float, float] | None:
-    """(the measured size used, its ratio) for a run of ``family`` at ``h_um``: the size nearest in log h;
-    None where the family has no measured run."""
+def calibration_for(ratios: dict[str, dict[float, tuple[int, float]]], family: str, h_um: float) -> float:
+    """The measured / projected ratio for a run of ``family`` at ``h_um``: that of the measured size nearest
+    in log h; 1 where the family has no measured run."""
     by_h = ratios.get(family)
     if not by_h:
-        return None
-    nearest = min(by_h, key=lambda h: (abs(math.log(h / h_um)), h))
-    return nearest, by_h[nearest][1]
+        return 1.0
+    return by_h[min(by_h, key=lambda h: (abs(math.log(h / h_um)), h))][1]
 
 
 def is_real_material(scene: Scene) -> bool:
@@ -181,21 +179,19 @@ def main() -> None:
         scene = Scene.from_dict(scene_dict)
         c, real, seconds = project_run(scene, throughput, material_factor)
         family = "real materials" if real else "rigid-plastic"
-        h_um = scene.discretisation.particle_size_m * 1e6
-        used = calibration_for(ratios, family, h_um) if ratios else None
-        scaled = seconds * (used[1] if used else 1.0)
+        h = round(scene.discretisation.particle_size_m * 1e6, 6)
+        scaled = seconds * calibration_for(ratios, family, h)
         calibrated[family] = calibrated.get(family, 0.0) + scaled
         if rid in skippable:
             skippable_s += seconds
             skippable_ps += c.particle_steps
             calibrated_skippable_s += scaled
-        h = round(scene.discretisation.particle_size_m * 1e6, 6)
         row = by_size.setdefault(h, {"runs": 0, "particle_steps": 0.0, "largest_run_particles": 0, "projected_s": 0.0})
         row["runs"] += 1
         row["particle_steps"] += c.particle_steps
         row["projected_s"] += seconds
         row["largest_run_particles"] = max(row["largest_run_particles"], c.particles)
-        fam = by_family["real materials" if real else "rigid-plastic"]
+        fam = by_family[family]
         fam["runs"] += 1
         fam["particle_steps"] += c.particle_steps
         fam["projected_s"] += seconds
