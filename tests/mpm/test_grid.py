@@ -37,10 +37,10 @@ def test_flags_of_a_symmetric_grid():
 
 
 def test_a_taller_grid_keeps_every_node_where_it_was_and_its_data_with_it():
-    from plough.mpm.grid import extend_node_array, taller
+    from plough.mpm.grid import extend_node_array, grown
 
     g = make_grid(300e-6, 80e-6, True, 10e-6, 20e-6)
-    t = taller(g, 4)
+    t = grown(g, 4)
     nx, ny, nz = g.shape
     assert t.shape == (nx, ny, nz + 4) and np.array_equal(t.origin, g.origin) and t.dx == g.dx
     old_pos = g.node_positions().reshape(nx, ny, nz, 3)
@@ -55,4 +55,29 @@ def test_a_taller_grid_keeps_every_node_where_it_was_and_its_data_with_it():
     top = extend_node_array(np.arange(g.n_nodes), g.shape, 4).reshape(nx, ny, nz + 4)
     assert np.array_equal(top[:, :, nz + 3], top[:, :, nz - 1])  # fill None: the old top layer again
     with pytest.raises(ValueError, match="extra_cells = 0"):
-        taller(g, 0)
+        grown(g, 0)
+    with pytest.raises(ValueError, match="axis = 1 must be 0"):
+        grown(g, 2, axis=1)
+
+
+def test_a_longer_grid_keeps_every_node_where_it_was_and_its_flags_are_the_longer_grids_own():
+    """Past the block's far end the flags depend on y and z alone: copying the last x layer gives exactly the
+    flags a grid made that long from the start has (x-major nodes: the new layers are appended)."""
+    from plough.mpm.grid import extend_node_array, grown
+
+    g = make_grid(300e-6, 80e-6, True, 10e-6, 20e-6)
+    t = grown(g, 5, axis=0)
+    nx, ny, nz = g.shape
+    assert t.shape == (nx + 5, ny, nz) and np.array_equal(t.origin, g.origin)
+    assert np.array_equal(t.node_positions()[:g.n_nodes], g.node_positions())
+    data = np.arange(g.n_nodes * 2, dtype=float).reshape(g.n_nodes, 2)
+    new = extend_node_array(data, g.shape, 5, fill=-1.0, grid_axis=0)
+    assert np.array_equal(new[:g.n_nodes], data) and np.all(new[g.n_nodes:] == -1.0)
+    per_chunk = np.stack([data, 2 * data])
+    new = extend_node_array(per_chunk, g.shape, 5, axis=1, fill=0.0, grid_axis=0)
+    assert new.shape == (2, t.n_nodes, 2) and np.array_equal(new[1, :g.n_nodes], 2 * data)
+    assert np.all(new[:, g.n_nodes:] == 0.0)
+    flags = extend_node_array(boundary_flags(g, 80e-6, True), g.shape, 5, grid_axis=0)
+    assert np.array_equal(flags, boundary_flags(t, 80e-6, True))
+    assert np.array_equal(boundary_flags(t, 80e-6, True), boundary_flags(make_grid(350e-6, 80e-6, True, 10e-6, 20e-6),
+                                                                        80e-6, True))

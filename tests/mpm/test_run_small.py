@@ -267,22 +267,123 @@ def test_a_particle_above_a_hand_set_grid_top_is_named_a_prow_and_points_at_the_
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "headroom" not in str(err.value)
 
 
-def test_a_particle_past_the_blocks_far_end_is_named_material_pushed_ahead(tiny_scene):
-    """Leaving through the far end (the soft coating's chip of the H~ = 0.25 run at h = 5 um) names the block's
-    length and how far ahead of the sphere; leaving through the near end keeps the general cause."""
-    state, const = solver.init(tiny_scene, n_chunks=1)
+def _flag_past_the_end(state, const, index=7, over_m=None):
+    """Mark particle ``index`` as having moved ``over_m`` (default a fifth of a cell) past the grid's far end."""
     state.work.acc[:] = 0.0
     state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
-    state.work.acc[0, transfers.ACC_BAD_INDEX] = 7
-    state.particles.x[7, 0] = const.grid_hi[0] + 0.2 * const.grid.dx
+    state.work.acc[0, transfers.ACC_BAD_INDEX] = index
+    state.particles.x[index, 0] = const.grid_hi[0] + (0.2 * const.grid.dx if over_m is None else over_m)
+
+
+def test_a_particle_past_a_fixed_grids_far_end_is_named_material_pushed_ahead(tiny_scene):
+    """With a hand-set headroom the grid does not grow: leaving through the far end (the soft coating's chip of
+    the H~ = 0.25 run at h = 5 um) names the block's length and how far ahead of the sphere; leaving through the
+    near end keeps the general cause."""
+    scene = tiny_scene.with_(domain=replace(tiny_scene.domain, headroom_m=tiny_scene.grid_headroom_m))
+    state, const = solver.init(scene, n_chunks=1)
+    assert const.grid_end_limit_m == 0.0
+    _flag_past_the_end(state, const)
     ahead = (state.particles.x[7, 0] - state.sphere.centre[0]) * 1e6
     with pytest.raises(solver.InstabilityError, match=rf"past the block's far end .* {ahead:.1f} um ahead of the "
-                                                      r"sphere's centre.*domain\.length_m"):
+                                                      r"sphere's centre.*domain\.length_m") as err:
         solver.check_stability(state, const)
+    assert "lengthens" not in str(err.value) and not state.grid_extensions
     state.particles.x[7, 0] = const.grid_lo[0] - 0.2 * const.grid.dx
     with pytest.raises(solver.InstabilityError) as err:
         solver.check_stability(state, const)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "far end" not in str(err.value)
+
+
+def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limit(tiny_scene):
+    """Room for the particle plus a quarter sphere radius, flags the longer grid's own, the run goes on; a
+    particle past the limit (two sphere radii past the block's end) stops it, naming the limit; the near end
+    never grows."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    r, dx = tiny_scene.sphere.radius_m, const.grid.dx
+    (nx, ny, nz), end0 = const.grid.shape, float(const.grid_hi[0])
+    assert const.grid_end_limit_m == pytest.approx(end0 + 2.0 * r, rel=1e-12)
+    _flag_past_the_end(state, const)
+    far = float(state.particles.x[7, 0])
+    solver.check_stability(state, const)  # no error
+    assert const.grid.shape[1:] == (ny, nz) and const.grid.shape[0] > nx
+    assert far + dx + 0.25 * r <= const.grid_hi[0] < far + 2.0 * dx + 0.25 * r
+    assert list(const.shape) == list(const.grid.shape) and np.array_equal(const.grid.origin, solver.init(
+        tiny_scene, n_chunks=1)[1].grid.origin)
+    assert state.zone.check_hi_m[0] == const.grid_hi[0] and state.zone.n_hi == const.grid.n_nodes
+    assert state.grid_extensions == [(state.step, state.sphere.slid_m, float(const.grid_hi[0]))]
+    assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
+    assert state.work.grid_buf.shape[1] == state.work.grid_m.size == state.work.last_push.size == const.grid.n_nodes
+    assert np.all(state.work.last_push[nx * ny * nz:] == contact.NEVER_PUSHED)
+    _flag_past_the_end(state, const, over_m=2.0 * r)
+    limit = rf"lengthens past the block's end by 2 sphere radii at most, to x = {const.grid_end_limit_m * 1e6:.1f}"
+    with pytest.raises(solver.InstabilityError, match=r"past the block's far end.*" + limit):
+        solver.check_stability(state, const)
+    assert len(state.grid_extensions) == 1
+    # past the limit by less than the quarter radius wanted: the grid ends at the limit
+    state2, const2 = solver.init(tiny_scene, n_chunks=1)
+    _flag_past_the_end(state2, const2, over_m=2.0 * r - 3.0 * dx)
+    solver.check_stability(state2, const2)
+    assert const2.grid_end_limit_m - dx < const2.grid_hi[0] <= const2.grid_end_limit_m + 1e-12
+    # a particle past the far end and above the top on one step: both grow
+    state3, const3 = solver.init(tiny_scene, n_chunks=1)
+    _flag_past_the_end(state3, const3)
+    state3.particles.x[7, 2] = const3.grid_hi[2] + 0.1 * dx
+    solver.check_stability(state3, const3)
+    assert len(state3.grid_extensions) == len(state3.grid_raises) == 1
+    state4, const4 = solver.init(tiny_scene, n_chunks=1)
+    _flag_past_the_end(state4, const4)
+    state4.particles.x[7, 0] = const4.grid_lo[0] - 0.2 * dx
+    with pytest.raises(solver.InstabilityError):
+        solver.check_stability(state4, const4)
+    assert not state4.grid_extensions
+
+
+def test_a_lengthening_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(tiny_scene, monkeypatch):
+    state, const = solver.init(tiny_scene, n_chunks=2)
+    shape = const.grid.shape
+    held = solver._array_bytes(state.particles) + solver._array_bytes(state.work)
+    w = state.work
+    per_layer = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push,
+                                       w.flags)) // shape[0]
+    for extra in (1, 4, shape[0]):
+        peak = held + max(per_layer * extra, w.grid_buf.nbytes // shape[0] * (shape[0] + extra))
+        assert solver.raise_bytes(state, shape, extra, axis=0) == peak
+        with pytest.raises(solver.InstabilityError, match=rf"passed the grid's far end, and lengthening it by {extra} "
+                                                          "node layers would hold"):
+            solver.check_raise_memory(state, shape, extra, peak - 1, axis=0)
+    _flag_past_the_end(state, const)  # a fifth of a cell past the end: needs 2 layers, wants a quarter radius more
+    need = solver.raise_bytes(state, shape, 2, axis=0)
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need)
+    solver.check_stability(state, const)
+    assert const.grid.shape[0] == shape[0] + 2 and len(state.grid_extensions) == 1
+
+
+@pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])
+def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_longer_grid(tiny_scene, zone):
+    """Lengthened mid-slide (contact memory and grid buffers in use, the zone at the block's end) against
+    lengthened at step 0: same particles, same forces."""
+    scene = tiny_scene.with_(discretisation=replace(tiny_scene.discretisation, active_zone_contact_radii=zone))
+    late, c_late = solver.init(scene, n_chunks=1)
+    while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6 and late.zone.p_hi == late.particles.n):
+        solver.step(late, c_late)  # until the zone reached the block's end: it must follow the new end
+    solver.grow_grid(late, c_late, 0, 6)
+    start, c_start = solver.init(scene, n_chunks=1)
+    solver.grow_grid(start, c_start, 0, 6)
+    assert c_start.grid.shape == c_late.grid.shape
+    assert np.array_equal(start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
+    for _ in range(late.step + 150 - start.step):
+        solver.step(start, c_start)
+    for _ in range(150):
+        solver.step(late, c_late)
+    assert start.step == late.step
+    assert late.zone.n_hi == start.zone.n_hi == c_late.grid.n_nodes
+    assert late.zone.check_hi_m[0] == start.zone.check_hi_m[0] == c_late.grid_hi[0]
+    for name in ("x", "v", "stress", "eps_p", "J"):
+        np.testing.assert_allclose(getattr(late.particles, name), getattr(start.particles, name),
+                                   rtol=1e-12, atol=1e-300, err_msg=name)
+    np.testing.assert_allclose(late.sphere.centre, start.sphere.centre, rtol=1e-12)
+    np.testing.assert_allclose(late.work.contact_out, start.work.contact_out, rtol=1e-10, atol=1e-18)
+    assert np.abs(late.particles.x - solver.init(scene, n_chunks=1)[0].particles.x).max() > 1e-7
 
 
 def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):

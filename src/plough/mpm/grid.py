@@ -54,31 +54,37 @@ def make_grid(length_m: float, radius_m: float, symmetric: bool, dx: float, head
     return Grid(origin=lo, dx=dx, shape=shape)
 
 
-def taller(grid: Grid, extra_cells: int) -> Grid:
-    """The same grid with ``extra_cells`` more node layers on top: every existing node keeps its
-    (i, j, k) and its position, since the origin sits at the bottom."""
+def grown(grid: Grid, extra_cells: int, axis: int = 2) -> Grid:
+    """The same grid with ``extra_cells`` more node layers at the high end of ``axis`` (2: on top, 0: past
+    the far end): every existing node keeps its (i, j, k) and its position, since the origin stays put."""
     if extra_cells < 1:
         raise ValueError(f"extra_cells = {extra_cells} must be >= 1")
-    nx, ny, nz = grid.shape
-    return Grid(origin=grid.origin, dx=grid.dx, shape=(nx, ny, nz + extra_cells))
+    if axis not in (0, 2):
+        raise ValueError(f"axis = {axis} must be 0 (x, the far end) or 2 (z, the top)")
+    shape = list(grid.shape)
+    shape[axis] += extra_cells
+    return Grid(origin=grid.origin, dx=grid.dx, shape=(shape[0], shape[1], shape[2]))
 
 
 def extend_node_array(data: np.ndarray, shape: tuple[int, int, int], extra_cells: int, axis: int = 0,
-                      fill: float | None = None) -> np.ndarray:
-    """Node data of a grid of ``shape`` (flat nodes along ``axis``) laid out on the grid with
-    ``extra_cells`` more layers on top. The new layers hold ``fill``, or with ``fill`` None a copy of
-    the old top layer (for the boundary flags: above the surface they depend on y alone)."""
-    nx, ny, nz = shape
+                      fill: float | None = None, grid_axis: int = 2) -> np.ndarray:
+    """Node data of a grid of ``shape`` (flat nodes along array ``axis``) laid out on the grid with
+    ``extra_cells`` more layers at the high end of ``grid_axis`` (:func:`grown`). The new layers hold
+    ``fill``, or with ``fill`` None a copy of the old last layer (for the boundary flags: above the
+    surface they depend on y alone, along x on y and z alone)."""
     data = np.ascontiguousarray(data)
     pre, post = data.shape[:axis], data.shape[axis + 1:]
+    new_shape = list(shape)
+    new_shape[grid_axis] += extra_cells
     # one allocation in the final layout (a copy through a moved axis held the new array twice: the
     # per-chunk P2G buffers are most of a run's node memory)
-    out = np.empty(pre + (nx * ny * (nz + extra_cells),) + post, dtype=data.dtype)
-    old = data.reshape(pre + (nx, ny, nz) + post)
-    new = out.reshape(pre + (nx, ny, nz + extra_cells) + post)
-    k = (slice(None),) * (len(pre) + 2)  # up to the z axis of the node index
-    new[k + (slice(0, nz),)] = old
-    new[k + (slice(nz, None),)] = old[k + (slice(nz - 1, nz),)] if fill is None else fill
+    out = np.empty(pre + (int(np.prod(new_shape)),) + post, dtype=data.dtype)
+    old = data.reshape(pre + tuple(shape) + post)
+    new = out.reshape(pre + tuple(new_shape) + post)
+    lead = (slice(None),) * (len(pre) + grid_axis)  # up to the grown axis of the node index
+    n = shape[grid_axis]
+    new[lead + (slice(0, n),)] = old
+    new[lead + (slice(n, None),)] = old[lead + (slice(n - 1, n),)] if fill is None else fill
     return out
 
 

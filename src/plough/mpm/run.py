@@ -129,7 +129,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     wall0 = time.perf_counter()
     state, const = solver.init(scene)
     max_press_steps = int(10 * scene.sphere.radius_m / (const.press_speed * const.dt))
-    grid_nodes_start = const.grid.n_nodes  # the grid may grow (solver.raise_grid_top)
+    grid_nodes_start = const.grid.n_nodes  # the grid may grow (solver.raise_grid_top, solver.lengthen_grid)
     rec = _Recorder(const.steps_slide / scene.outputs.records)
     n_snap = scene.outputs.snapshots
     snap_every = scene.sliding.distance_m / n_snap if n_snap else np.inf
@@ -139,7 +139,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     stopper = SteadyStop(scene) if scene.sliding.stop_when_steady else None
     slid_distance = scene.sliding.distance_m
     active_particle_steps = 0
-    raises_told = 0
+    raises_told = extensions_told = 0
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
@@ -163,6 +163,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                 step_no, slid_m, top_m = state.grid_raises[-1]
                 bar.write(f"{scene.name}: material reached the grid's top at step {step_no} ({slid_m * 1e6:.1f} um "
                           f"slid); the grid's top raised to {top_m * 1e6:.1f} um above the original surface")
+            if bar is not None and len(state.grid_extensions) > extensions_told:
+                extensions_told = len(state.grid_extensions)
+                step_no, slid_m, end_m = state.grid_extensions[-1]
+                bar.write(f"{scene.name}: material passed the block's far end at step {step_no} ({slid_m * 1e6:.1f} "
+                          f"um slid); the grid lengthened to x = {end_m * 1e6:.1f} um")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)
     finally:
@@ -181,7 +186,8 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
             "dt_s": const.dt, "particle_steps": active_particle_steps,
             "active_fraction": active_particle_steps / max(n * state.step, 1),
             "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads(),
-            "grid_top_m": float(const.grid_hi[2]), "grid_top_raises": len(state.grid_raises)}
+            "grid_top_m": float(const.grid_hi[2]), "grid_top_raises": len(state.grid_raises),
+            "grid_end_m": float(const.grid_hi[0]), "grid_end_extensions": len(state.grid_extensions)}
     ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
                           rec.max_penetration, coating_row, slid_distance_m=slid_distance)
     warn_if_unsteady(ds, scene.name)

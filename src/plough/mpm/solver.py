@@ -22,8 +22,9 @@ slabs around them (:class:`ActiveZone`): particles and nodes are stored x-major,
 index ranges; the material beyond is frozen and clamps the active part.
 
 Material that rises past the grid's top (a prow that keeps growing) raises it mid-run where the
-scene leaves the headroom automatic (:func:`raise_grid_top`); any other particle leaving the grid,
-and a hand-set headroom, stop the run (:func:`check_stability`).
+scene leaves the headroom automatic (:func:`raise_grid_top`), and material flung past the block's far
+end (fragments of a soft coating's chip) lengthens it (:func:`lengthen_grid`); any other particle
+leaving the grid, and a hand-set headroom, stop the run (:func:`check_stability`).
 """
 
 from __future__ import annotations
@@ -42,7 +43,7 @@ from plough.materials import (
 )
 from plough.mpm import contact, transfers
 from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
-from plough.mpm.grid import Grid, boundary_flags, extend_node_array, make_grid, mirror_plane_index, taller
+from plough.mpm.grid import Grid, boundary_flags, extend_node_array, grown, make_grid, mirror_plane_index
 from plough.mpm.particles import Particles, seed_particles, uniform_particle_count
 from plough.mpm.scene import Scene
 
@@ -67,6 +68,13 @@ ZONE_PAD_CELLS = 4
 #: pile-up (H~ = 0.1 at h = 10 um: 197 um after 600 um of sliding, README *Status*), but material
 #: above the sphere is flung, not ploughed
 GRID_TOP_LIMIT_RADII = 2.0
+#: with the automatic headroom the grid also lengthens past the block's far end, up to this many sphere
+#: radii: a soft coating's chip sheds fragments the 1e6 mass scaling flings ahead of the sphere (H~ = 0.25 at
+#: h = 5 um: up to 377 um ahead, at 4.5x the slide speed, README *Status*); they stay in the run
+GRID_END_LIMIT_RADII = 2.0
+#: each lengthening adds room for the farthest particle plus this many sphere radii, so that fragments
+#: flying on do not reallocate the grid every few steps
+GRID_END_STEP_RADII = 0.25
 
 
 class SimulationError(RuntimeError):
@@ -126,6 +134,8 @@ class Constants:
     #: m, the highest the grid's top may be raised to when material reaches it (``raise_grid_top``); 0: never
     #: (a headroom the scene sets by hand is kept)
     grid_top_limit_m: float = 0.0
+    #: m, the farthest the grid's far end may move to when material passes it (``lengthen_grid``); 0: never
+    grid_end_limit_m: float = 0.0
 
 
 @dataclass
@@ -183,6 +193,8 @@ class State:
     time: float = 0.0
     #: (step, sliding distance m, new grid top m) of each raise of the grid's top (``raise_grid_top``)
     grid_raises: list[tuple[int, float, float]] = field(default_factory=list)
+    #: (step, sliding distance m, new grid end m) of each lengthening past the far end (``lengthen_grid``)
+    grid_extensions: list[tuple[int, float, float]] = field(default_factory=list)
 
 
 # ----------------------------------------------------------------------------- set-up
@@ -271,6 +283,8 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
         shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
         grid_top_limit_m=GRID_TOP_LIMIT_RADII * r if scene.domain.headroom_m is None else 0.0,
+        grid_end_limit_m=(float(grid.upper[0] - dx) + GRID_END_LIMIT_RADII * r
+                          if scene.domain.headroom_m is None else 0.0),
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
@@ -459,18 +473,17 @@ CAUSES = {
 
 def check_stability(s: State, c: Constants) -> None:
     """Stop at once, naming the step, the sliding distance and the likely cause; a particle past an
-    automatic grid top raises the top instead (:func:`raise_grid_top`) where that holds every particle
-    and fits in memory."""
+    automatic grid top raises the top (:func:`raise_grid_top`), one past the block's far end lengthens
+    the grid (:func:`lengthen_grid`), where that holds every particle and fits in memory."""
     acc = s.work.acc
     bad = int(acc[:, transfers.ACC_BAD].max())
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
     chunk = int(np.argmax(acc[:, transfers.ACC_BAD]))
     index = int(acc[chunk, transfers.ACC_BAD_INDEX])
-    if (bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]
-            and raise_grid_top(s, c)):
-        index = _outside_index(s)
+    if bad == transfers.BAD_LEFT_GRID and index >= 0:
+        index = _grow_to_hold(s, c, index)
         if index < 0:
-            bad = transfers.BAD_NONE  # the raised grid holds every particle
+            bad = transfers.BAD_NONE  # the grown grid holds every particle
     if bad != transfers.BAD_NONE:
         cause = CAUSES[bad]
         if bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]:
@@ -481,10 +494,12 @@ def check_stability(s: State, c: Constants) -> None:
                      f"particle flung off the surface (lower mass_scaling or speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 0] > c.grid_hi[0]:
             ahead = (s.particles.x[index, 0] - s.sphere.centre[0]) * 1e6
+            limit = (f"; the grid lengthens past the block's end by {GRID_END_LIMIT_RADII:g} sphere radii at most, "
+                     f"to x = {c.grid_end_limit_m * 1e6:.1f} um" if c.grid_end_limit_m > 0.0 else "")
             cause = (f"a particle moved past the block's far end (x = {c.grid_hi[0] * 1e6:.1f} um), {ahead:.1f} um "
                      "ahead of the sphere's centre: material the sphere pushes ahead of it (a prow or chip of a soft "
                      "coating: lengthen domain.length_m) or a particle flung off the surface (lower mass_scaling or "
-                     "speed)")
+                     f"speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
             zone = s.zone
             cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo_m[0] * 1e6:.1f}.."
@@ -500,6 +515,19 @@ def check_stability(s: State, c: Constants) -> None:
                               "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")
 
 
+def _grow_to_hold(s: State, c: Constants, index: int) -> int:
+    """Raise the grid's top and lengthen it past the far end as far as the particles outside need and the
+    limits allow; the particle still outside afterwards (``index`` where nothing grew), -1 if none."""
+    x = s.particles.x
+    if x[index, 2] > c.grid_hi[2] and raise_grid_top(s, c):
+        index = _outside_index(s)
+    if index >= 0 and x[index, 0] > c.grid_hi[0] and lengthen_grid(s, c):
+        index = _outside_index(s)
+    if index >= 0 and x[index, 2] > c.grid_hi[2] and raise_grid_top(s, c):  # one outside through both faces
+        index = _outside_index(s)
+    return index
+
+
 def raise_grid_top(s: State, c: Constants) -> bool:
     """Raise the grid's top mid-run so that every active particle has room again; False where the
     scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``; stops the run
@@ -507,74 +535,125 @@ def raise_grid_top(s: State, c: Constants) -> bool:
 
     The room above the surface at least doubles (a few raises cover any prow; only the room needed
     where the doubled one would not fit in memory), one cell above the highest particle at least,
-    and stops at the limit. The origin is at the bottom, so every node
-    keeps its (i, j, k) and position: the per-node arrays are copied into the taller layout (new
-    layers empty, contact memory unpushed, flags those of the old top layer, as above the surface
-    they depend on y alone) and the run goes on as if it had started on the taller grid. A particle past the old top on
-    this step moved with a complete stencil on the old grid (it was inside before the move).
+    and stops at the limit. The new layers' flags are those of the old top layer (above the surface
+    they depend on y alone); see :func:`grow_grid`.
     """
     if c.grid_top_limit_m <= 0.0:
         return False
-    g, z, w = c.grid, s.zone, s.work
+    z = s.zone
     top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
     now = float(c.grid_hi[2])
     # node layers to add: needed by the highest particle, wanted (the room doubled), allowed (the limit)
-    need = math.ceil((top + g.dx - now) / g.dx - 1e-9)
-    wanted = math.ceil((max(2.0 * now, top + g.dx) - now) / g.dx - 1e-9)
-    allowed = math.floor((c.grid_top_limit_m - now) / g.dx + 1e-9)
+    need = math.ceil((top + c.grid.dx - now) / c.grid.dx - 1e-9)
+    wanted = math.ceil((max(2.0 * now, top + c.grid.dx) - now) / c.grid.dx - 1e-9)
+    allowed = math.floor((c.grid_top_limit_m - now) / c.grid.dx + 1e-9)
+    if not _grow_within(s, c, 2, need, wanted, allowed):
+        return False
+    s.grid_raises.append((s.step, s.sphere.slid_m, float(c.grid_hi[2])))
+    return True
+
+
+def lengthen_grid(s: State, c: Constants) -> bool:
+    """Lengthen the grid past the block's far end mid-run so that every active particle has room again
+    (fragments of a soft coating's chip flung ahead of the sphere); False where the scene set its headroom
+    by hand (a fixed grid) or the room would pass ``Constants.grid_end_limit_m``; stops the run
+    (:func:`check_raise_memory`) where it would not fit in memory.
+
+    The room reaches one cell past the farthest particle plus ``GRID_END_STEP_RADII`` sphere radii, and stops
+    at the limit. Past the block's end the nodes' flags depend on y and z alone (the curved surface, the
+    mirror plane), so the new x layers copy the old last one; see :func:`grow_grid`.
+    """
+    if c.grid_end_limit_m <= 0.0:
+        return False
+    z = s.zone
+    far = float(s.particles.x[z.p_lo:z.p_hi, 0].max())
+    now = float(c.grid_hi[0])
+    need = math.ceil((far + c.grid.dx - now) / c.grid.dx - 1e-9)
+    wanted = math.ceil((far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius - now) / c.grid.dx - 1e-9)
+    allowed = math.floor((c.grid_end_limit_m - now) / c.grid.dx + 1e-9)
+    if not _grow_within(s, c, 0, need, wanted, allowed):
+        return False
+    s.grid_extensions.append((s.step, s.sphere.slid_m, float(c.grid_hi[0])))
+    return True
+
+
+def _grow_within(s: State, c: Constants, axis: int, need: int, wanted: int, allowed: int) -> bool:
+    """Grow the grid along ``axis`` by the ``wanted`` node layers, or fewer down to the ``need``ed ones where
+    the limit (``allowed``) or the memory says so; False, nothing grown, where even those pass the limit."""
     extra = min(wanted, allowed)
     if extra < max(need, 1):
         return False
     available = physical_memory_bytes()
-    if available is not None and raise_bytes(s, g.shape, extra) > available and extra > max(need, 1):
-        extra = max(need, 1)  # the doubled room does not fit in memory: the room the particles need
-    check_raise_memory(s, g.shape, extra, available)
-    shape, new = g.shape, taller(g, extra)
-    w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0)
-    w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0)
-    w.grid_v = extend_node_array(w.grid_v, shape, extra, fill=0.0)
-    w.grid_div = extend_node_array(w.grid_div, shape, extra, fill=0.0)
-    w.cbuf = extend_node_array(w.cbuf, shape, extra, fill=0.0)
-    w.last_push = extend_node_array(w.last_push, shape, extra, fill=contact.NEVER_PUSHED)
-    w.flags = extend_node_array(w.flags, shape, extra)
+    if available is not None and raise_bytes(s, c.grid.shape, extra, axis) > available and extra > max(need, 1):
+        extra = max(need, 1)  # the wanted room does not fit in memory: the room the particles need
+    check_raise_memory(s, c.grid.shape, extra, available, axis)
+    grow_grid(s, c, axis, extra)
+    return True
+
+
+def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
+    """Add ``extra`` node layers at the high end of ``axis`` (2: the top, 0: past the far end).
+
+    The origin stays put, so every node keeps its (i, j, k) and position: the per-node arrays are copied
+    into the grown layout (new layers empty, contact memory unpushed, flags copied from the old last layer)
+    and the run goes on as if it had started on the grown grid. The active zone's node range, free slabs
+    and positions check follow the new far end where they reached the old one. A particle outside the old
+    grid on this step moved with a complete stencil on it (it was inside before the move).
+    """
+    g, z, w = c.grid, s.zone, s.work
+    shape, new = g.shape, grown(g, extra, axis)
+    w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0, grid_axis=axis)
+    w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0, grid_axis=axis)
+    w.grid_v = extend_node_array(w.grid_v, shape, extra, fill=0.0, grid_axis=axis)
+    w.grid_div = extend_node_array(w.grid_div, shape, extra, fill=0.0, grid_axis=axis)
+    w.cbuf = extend_node_array(w.cbuf, shape, extra, fill=0.0, grid_axis=axis)
+    w.last_push = extend_node_array(w.last_push, shape, extra, fill=contact.NEVER_PUSHED, grid_axis=axis)
+    w.flags = extend_node_array(w.flags, shape, extra, grid_axis=axis)
     old_slab, new_slab = shape[1] * shape[2], new.shape[1] * new.shape[2]
-    z.n_lo, z.n_hi = z.n_lo // old_slab * new_slab, z.n_hi // old_slab * new_slab
+    if axis == 2:  # x-major: the zone's node range keeps its slabs, each slab taller
+        z.n_lo, z.n_hi = z.n_lo // old_slab * new_slab, z.n_hi // old_slab * new_slab
+    else:  # the slabs keep their size; a zone that reached the old far end reaches the new one
+        z.n_hi = new.n_nodes if z.n_hi == g.n_nodes else z.n_hi
+        z.i_free_hi = new.shape[0] if z.i_free_hi == shape[0] else z.i_free_hi
+    old_hi = c.grid_hi.copy()
     c.grid, c.shape = new, np.array(new.shape, dtype=np.int64)
     c.grid_hi = new.upper - 1.0 * new.dx
-    z.check_hi_m[2] = c.grid_hi[2]
-    s.grid_raises.append((s.step, s.sphere.slid_m, float(c.grid_hi[2])))
-    return True
+    if z.check_hi_m[axis] == old_hi[axis]:
+        z.check_hi_m[axis] = c.grid_hi[axis]
 
 
 def _array_bytes(obj: object) -> int:
     return sum(v.nbytes for v in vars(obj).values() if isinstance(v, np.ndarray))
 
 
-def raise_bytes(s: State, shape: tuple[int, int, int], extra: int) -> int:
-    """Bytes the run holds at the peak of a raise of the grid's top by ``extra`` node layers: its particle
-    and per-node arrays, plus the layers added, or the new per-chunk P2G buffers while the old ones are still
-    held (most of a run's node memory), whichever is more."""
+def raise_bytes(s: State, shape: tuple[int, int, int], extra: int, axis: int = 2) -> int:
+    """Bytes the run holds at the peak of growing the grid by ``extra`` node layers along ``axis``: its
+    particle and per-node arrays, plus the layers added, or the new per-chunk P2G buffers while the old ones
+    are still held (most of a run's node memory), whichever is more."""
     node_arrays = (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div, s.work.cbuf,
                    s.work.last_push, s.work.flags)
-    added = sum(a.nbytes for a in node_arrays) * extra // shape[2]  # x-major nodes: nx ny extra more of nx ny nz
-    new_buffers = s.work.grid_buf.nbytes * (shape[2] + extra) // shape[2]
+    added = sum(a.nbytes for a in node_arrays) * extra // shape[axis]  # one layer is 1 / shape[axis] of the nodes
+    new_buffers = s.work.grid_buf.nbytes * (shape[axis] + extra) // shape[axis]
     return _array_bytes(s.particles) + _array_bytes(s.work) + max(added, new_buffers)
 
 
-def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None) -> None:
-    """Stop before a raise of the grid's top by ``extra`` node layers that would not fit in ``available``
-    bytes, this machine's physical memory (:func:`raise_bytes`; ``check_memory`` counted the particles
-    alone, before the grid could grow); None: not known, no check. The whole machine's memory: jobs beside
-    the run are not counted."""
+def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None,
+                       axis: int = 2) -> None:
+    """Stop before growing the grid by ``extra`` node layers along ``axis`` where that would not fit in
+    ``available`` bytes, this machine's physical memory (:func:`raise_bytes`; ``check_memory`` counted the
+    particles alone, before the grid could grow); None: not known, no check. The whole machine's memory:
+    jobs beside the run are not counted."""
     if available is None:
         return
-    peak = raise_bytes(s, shape, extra)
+    peak = raise_bytes(s, shape, extra, axis)
     if peak > available:
+        what = ("rose above the grid's top, and raising it" if axis == 2
+                else "passed the grid's far end, and lengthening it")
         raise InstabilityError(
-            f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material rose above "
-            f"the grid's top, and raising it by {extra} node layers would hold {peak / 2**30:.3g} GiB, more than "
-            f"this machine's {available / 2**30:.3g} GiB of memory (a growing prow: coarser particles, a "
-            "smaller domain, or a hand-set domain.headroom_m to stop there)")
+            f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material {what} "
+            f"by {extra} node layers would hold {peak / 2**30:.3g} GiB, more than this machine's "
+            f"{available / 2**30:.3g} GiB of memory (a growing prow or chip: coarser particles, a smaller domain, "
+            "or a hand-set domain.headroom_m to stop there)")
 
 
 def _outside_index(s: State) -> int:
