@@ -284,8 +284,9 @@ def test_a_particle_past_a_fixed_grids_far_end_is_named_material_pushed_ahead(ti
     assert const.grid_end_limit_m == 0.0
     _flag_past_the_end(state, const)
     ahead = (state.particles.x[7, 0] - state.sphere.centre[0]) * 1e6
-    with pytest.raises(solver.InstabilityError, match=rf"past the block's far end .* {ahead:.1f} um ahead of the "
-                                                      r"sphere's centre.*domain\.length_m") as err:
+    end = tiny_scene.domain.length_m * 1e6
+    where = rf"past the grid's far end .*the block ends at {end:.1f} um\), {ahead:.1f} um ahead of the sphere's centre"
+    with pytest.raises(solver.InstabilityError, match=where + r".*domain\.length_m") as err:
         solver.check_stability(state, const)
     assert "lengthens" not in str(err.value) and not state.grid_extensions
     state.particles.x[7, 0] = const.grid_lo[0] - 0.2 * const.grid.dx
@@ -301,7 +302,8 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
     state, const = solver.init(tiny_scene, n_chunks=1)
     r, dx = tiny_scene.sphere.radius_m, const.grid.dx
     (nx, ny, nz), end0 = const.grid.shape, float(const.grid_hi[0])
-    assert const.grid_end_limit_m == pytest.approx(end0 + 2.0 * r, rel=1e-12)
+    assert const.grid_end_limit_m == pytest.approx(tiny_scene.domain.length_m + 2.0 * r, rel=1e-12)
+    assert end0 > tiny_scene.domain.length_m  # the grid starts a few cells past the block
     _flag_past_the_end(state, const)
     far = float(state.particles.x[7, 0])
     solver.check_stability(state, const)  # no error
@@ -310,13 +312,14 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
     assert list(const.shape) == list(const.grid.shape) and np.array_equal(const.grid.origin, solver.init(
         tiny_scene, n_chunks=1)[1].grid.origin)
     assert state.zone.check_hi_m[0] == const.grid_hi[0] and state.zone.n_hi == const.grid.n_nodes
+    assert state.zone.i_free_hi == const.grid.shape[0]  # the new layers are free, not clamped
     assert state.grid_extensions == [(state.step, state.sphere.slid_m, float(const.grid_hi[0]))]
     assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
     assert state.work.grid_buf.shape[1] == state.work.grid_m.size == state.work.last_push.size == const.grid.n_nodes
     assert np.all(state.work.last_push[nx * ny * nz:] == contact.NEVER_PUSHED)
     _flag_past_the_end(state, const, over_m=2.0 * r)
     limit = rf"lengthens past the block's end by 2 sphere radii at most, to x = {const.grid_end_limit_m * 1e6:.1f}"
-    with pytest.raises(solver.InstabilityError, match=r"past the block's far end.*" + limit):
+    with pytest.raises(solver.InstabilityError, match=r"past the grid's far end.*" + limit):
         solver.check_stability(state, const)
     assert len(state.grid_extensions) == 1
     # past the limit by less than the quarter radius wanted: the grid ends at the limit
@@ -324,18 +327,39 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
     _flag_past_the_end(state2, const2, over_m=2.0 * r - 3.0 * dx)
     solver.check_stability(state2, const2)
     assert const2.grid_end_limit_m - dx < const2.grid_hi[0] <= const2.grid_end_limit_m + 1e-12
-    # a particle past the far end and above the top on one step: both grow
-    state3, const3 = solver.init(tiny_scene, n_chunks=1)
-    _flag_past_the_end(state3, const3)
-    state3.particles.x[7, 2] = const3.grid_hi[2] + 0.1 * dx
-    solver.check_stability(state3, const3)
-    assert len(state3.grid_extensions) == len(state3.grid_raises) == 1
+    # a particle past the far end and above the top on one step, or one past the end (the flagged one) and
+    # another above the top: both grow
+    for other in (7, 9):
+        state3, const3 = solver.init(tiny_scene, n_chunks=1)
+        _flag_past_the_end(state3, const3)
+        state3.particles.x[other, 2] = const3.grid_hi[2] + 0.1 * dx
+        solver.check_stability(state3, const3)
+        assert len(state3.grid_extensions) == len(state3.grid_raises) == 1, other
+        assert solver._outside_index(state3) == -1
     state4, const4 = solver.init(tiny_scene, n_chunks=1)
     _flag_past_the_end(state4, const4)
     state4.particles.x[7, 0] = const4.grid_lo[0] - 0.2 * dx
     with pytest.raises(solver.InstabilityError):
         solver.check_stability(state4, const4)
     assert not state4.grid_extensions
+
+
+def test_a_particle_flung_past_the_far_end_flies_on_over_the_lengthened_grid(tiny_scene):
+    """Behaviour, not bookkeeping: a lone particle flung along x above the surface near the block's end (no
+    stress, nothing near it) keeps its velocity as it crosses into the new x layers; nodes past the old end
+    left clamped (frozen slabs) would stop it."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    p, dx = state.particles, const.grid.dx
+    i = int(np.argmax(p.x[:, 0] + p.x[:, 2]))  # a top particle at the far end
+    p.x[i] = [const.grid_hi[0] - 0.3 * dx, p.x[i, 1], 3.0 * dx]
+    p.stress[i] = 0.0
+    p.C[i] = 0.0
+    v0 = 0.08 * dx / const.dt  # slow enough for the kinetic energy check
+    p.v[i] = [v0, 0.0, 0.0]
+    for _ in range(45):
+        solver.step(state, const)
+    assert state.grid_extensions and p.x[i, 0] > const.block_end_m + 2.0 * dx + 2.5 * dx
+    assert p.v[i, 0] == pytest.approx(v0, rel=1e-6) and abs(p.v[i, 2]) < 1e-6 * v0
 
 
 def test_a_lengthening_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(tiny_scene, monkeypatch):
@@ -503,10 +527,14 @@ def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatc
     assert tiny_run.attrs["cost_grid_nodes"] == tiny_run.attrs["cost_grid_nodes_end"] == const.grid.n_nodes
     real_step = solver.step
 
-    def step_raising_once(s, c):  # as check_stability would on a particle past the top
+    def step_raising_once(s, c):  # as check_stability would on a particle past the top, then past the end
         real_step(s, c)
         if s.step == 40:
             assert solver.raise_grid_top(s, c)
+        if s.step == 50:
+            s.particles.x[3, 0] = c.grid_hi[0] + 0.1 * c.grid.dx
+            assert solver.lengthen_grid(s, c)
+            s.particles.x[3, 0] -= 0.1 * c.grid.dx
 
     monkeypatch.setattr(solver, "step", step_raising_once)
     short = tiny_scene.with_(sliding=replace(tiny_scene.sliding, distance_m=100e-6))
@@ -516,7 +544,13 @@ def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatc
     assert ds.attrs["cost_grid_top_raises"] == 1
     assert ds.attrs["cost_grid_top_m"] >= 2.0 * const.grid_hi[2]
     assert ds.attrs["cost_grid_nodes_end"] > ds.attrs["cost_grid_nodes"] == const.grid.n_nodes
-    assert "material reached the grid's top at step 40" in capsys.readouterr().out
+    told = capsys.readouterr().out
+    assert "material reached the grid's top at step 40" in told
+    assert "material passed the grid's far end at step 50" in told and "the grid lengthened to x = " in told
+    assert tiny_run.attrs["cost_grid_end_extensions"] == 0
+    assert tiny_run.attrs["cost_grid_end_m"] == pytest.approx(const.grid_hi[0], rel=1e-12)
+    assert ds.attrs["cost_grid_end_extensions"] == 1
+    assert ds.attrs["cost_grid_end_m"] > const.grid_hi[0] + 0.25 * tiny_scene.sphere.radius_m
 
 
 def test_grid_top_follows_the_headroom(tiny_scene):

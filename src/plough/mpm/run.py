@@ -166,7 +166,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
             if bar is not None and len(state.grid_extensions) > extensions_told:
                 extensions_told = len(state.grid_extensions)
                 step_no, slid_m, end_m = state.grid_extensions[-1]
-                bar.write(f"{scene.name}: material passed the block's far end at step {step_no} ({slid_m * 1e6:.1f} "
+                bar.write(f"{scene.name}: material passed the grid's far end at step {step_no} ({slid_m * 1e6:.1f} "
                           f"um slid); the grid lengthened to x = {end_m * 1e6:.1f} um")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)

@@ -175,8 +175,9 @@ class Domain:
     ``headroom_m`` is the height of the grid above the original surface, the room material has to
     rise into (pile-up, and the prow an adhesive interface pushes up the sphere's front); None
     sizes it from the expected groove (``Scene.grid_headroom_m``) and lets the solver raise it
-    mid-run where material reaches it (``solver.raise_grid_top``); a value set here is kept. It
-    costs grid nodes, not particles.
+    mid-run where material reaches it (``solver.raise_grid_top``), and lengthen it past the block's
+    far end where material flung ahead passes it (``solver.lengthen_grid``); a value set here fixes
+    the whole grid, the top and the far end. It costs grid nodes, not particles.
     """
 
     radius_m: float = 200e-6
@@ -518,7 +519,8 @@ class Scene:
         the sphere sweeps ahead) outgrows any fixed rule, and one expected contact radius more would
         cost 9-22% more grid nodes at h <= 5 um on the reference scenes: with this automatic value
         the solver raises the grid's top mid-run where material reaches it
-        (``solver.raise_grid_top``)."""
+        (``solver.raise_grid_top``) and lengthens the grid past the block's far end
+        (``solver.lengthen_grid``)."""
         if self.domain.headroom_m is not None:
             return self.domain.headroom_m
         _, dp = self.expected_contact()

@@ -101,7 +101,7 @@ class SphereState:
 @dataclass
 class Constants:
     """Everything a step needs that does not change during a run, but for the grid (``grid``, ``shape``,
-    ``grid_hi``) when its top is raised (:func:`raise_grid_top`)."""
+    ``grid_hi``) when its top is raised (:func:`raise_grid_top`) or it is lengthened (:func:`lengthen_grid`)."""
 
     dt: float
     grid: Grid
@@ -136,6 +136,7 @@ class Constants:
     grid_top_limit_m: float = 0.0
     #: m, the farthest the grid's far end may move to when material passes it (``lengthen_grid``); 0: never
     grid_end_limit_m: float = 0.0
+    block_end_m: float = 0.0  # m, x of the block's far end face (the grid starts a few cells past it)
 
 
 @dataclass
@@ -283,8 +284,9 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
         shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
         grid_top_limit_m=GRID_TOP_LIMIT_RADII * r if scene.domain.headroom_m is None else 0.0,
-        grid_end_limit_m=(float(grid.upper[0] - dx) + GRID_END_LIMIT_RADII * r
-                          if scene.domain.headroom_m is None else 0.0),
+        grid_end_limit_m=(scene.domain.length_m + GRID_END_LIMIT_RADII * r if scene.domain.headroom_m is None
+                          else 0.0),
+        block_end_m=scene.domain.length_m,
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
@@ -496,10 +498,10 @@ def check_stability(s: State, c: Constants) -> None:
             ahead = (s.particles.x[index, 0] - s.sphere.centre[0]) * 1e6
             limit = (f"; the grid lengthens past the block's end by {GRID_END_LIMIT_RADII:g} sphere radii at most, "
                      f"to x = {c.grid_end_limit_m * 1e6:.1f} um" if c.grid_end_limit_m > 0.0 else "")
-            cause = (f"a particle moved past the block's far end (x = {c.grid_hi[0] * 1e6:.1f} um), {ahead:.1f} um "
-                     "ahead of the sphere's centre: material the sphere pushes ahead of it (a prow or chip of a soft "
-                     "coating: lengthen domain.length_m) or a particle flung off the surface (lower mass_scaling or "
-                     f"speed){limit}")
+            cause = (f"a particle moved past the grid's far end (x = {c.grid_hi[0] * 1e6:.1f} um; the block ends at "
+                     f"{c.block_end_m * 1e6:.1f} um), {ahead:.1f} um ahead of the sphere's centre: material the sphere "
+                     "pushes ahead of it (a prow or chip of a soft coating: lengthen domain.length_m) or a particle "
+                     f"flung off the surface (lower mass_scaling or speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
             zone = s.zone
             cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo_m[0] * 1e6:.1f}.."
@@ -523,7 +525,7 @@ def _grow_to_hold(s: State, c: Constants, index: int) -> int:
         index = _outside_index(s)
     if index >= 0 and x[index, 0] > c.grid_hi[0] and lengthen_grid(s, c):
         index = _outside_index(s)
-    if index >= 0 and x[index, 2] > c.grid_hi[2] and raise_grid_top(s, c):  # one outside through both faces
+    if index >= 0 and x[index, 2] > c.grid_hi[2] and raise_grid_top(s, c):  # another above the top, found now
         index = _outside_index(s)
     return index
 

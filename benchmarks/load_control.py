@@ -1,0 +1,128 @@
+"""How well the load control holds the load, and what a stiffer controller would change.
+
+    python benchmarks/load_control.py [--config config/preview.yaml] [--size-um 20] [--match REGEX]
+        [--setting 1,100] [--setting 0.3,30] [--trace RUN] [--out FILE]
+
+For every MPM run of the config at one particle size (optionally those whose id matches ``--match``), each
+``--setting`` ``STIFFNESS_FACTOR,INTEGRAL_STEPS`` of ``plough.mpm.solver`` (the gain from the elastic contact
+stiffness times the factor, the integral time in steps; the defaults are 1, 100) runs the scene on one thread
+and records the mean Fz over the steady window against the load, mu, dp, whether the window is steady, and
+the spread of the sphere's depth and of Fz over the window. With ``--trace RUN`` the first setting's run of
+that id is stepped by hand instead and the load controller's integral is read at the window's ends: the
+window's mean load error is the integral's change over the window divided by its duration (the integral
+integrates the filtered error on every unbounded step), which says where a missed load comes from.
+
+Writes ``--out`` (default benchmarks/results/load_control_h<size>.json) and prints a table and a summary
+(runs within 1% of the load, the largest miss, the changes in mu and dp between the settings).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import statistics
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from plough.mpm import solver
+from plough.mpm.run import simulate
+from plough.mpm.scene import Scene
+from plough.study import matrix
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def set_controller(stiffness_factor: float, integral_steps: float) -> None:
+    """The load controller's constants for the runs that follow (module constants of ``plough.mpm.solver``,
+    read at ``init`` and on every step)."""
+    solver.STIFFNESS_FACTOR = stiffness_factor
+    solver.INTEGRAL_STEPS = integral_steps
+
+
+def measure(scene: Scene) -> dict[str, float]:
+    wall0 = time.perf_counter()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # an unsteady window is recorded below, not warned about
+        ds = simulate(scene, progress=False, threads=1)
+    w = ds.in_steady_window.values.astype(bool)
+    return {"fz_over_load": float(ds.Fz_mean) / scene.load_N, "mu": float(ds.mu), "dp_um": float(ds.dp) * 1e6,
+            "steady": int(ds.steady), "depth_sd_um": float(np.std(ds.depth.values[w])) * 1e6,
+            "fz_sd_over_load": float(np.std(ds.Fz.values[w])) / scene.load_N,
+            "wall_s": time.perf_counter() - wall0}
+
+
+def trace(scene: Scene) -> dict[str, float]:
+    """Step the scene by hand; the controller's integral and the filtered Fz over the steady window."""
+    s, c = solver.init(scene, n_chunks=1)
+    lo, hi = (f * scene.sliding.distance_m for f in scene.outputs.steady_window)
+    start = end = None
+    filtered = []
+    while s.sphere.phase != "done":
+        solver.step(s, c)
+        if s.sphere.phase == "slide" and lo <= s.sphere.slid_m <= hi:
+            if start is None:
+                start = (s.time, s.sphere.load_error_integral)
+            end = (s.time, s.sphere.load_error_integral)
+            filtered.append(s.sphere.fz_filtered)
+    duration = end[0] - start[0]
+    return {"window_s": duration, "integral_start_Ns": start[1], "integral_end_Ns": end[1],
+            "integral_change_over_window_N": (end[1] - start[1]) / duration,
+            "mean_filtered_error_N": scene.load_N - float(np.mean(filtered)), "load_N": scene.load_N}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--config", default=str(ROOT / "config" / "preview.yaml"))
+    parser.add_argument("--size-um", type=float, default=20.0)
+    parser.add_argument("--match", default="", help="only the run ids this regular expression finds")
+    parser.add_argument("--setting", action="append", default=None,
+                        help="STIFFNESS_FACTOR,INTEGRAL_STEPS (repeatable; default 1,100 and 0.3,30)")
+    parser.add_argument("--trace", default=None, help="a run id to trace the controller's integral in")
+    parser.add_argument("--out", default=None)
+    args = parser.parse_args()
+    settings = [tuple(float(v) for v in s.split(",")) for s in (args.setting or ["1,100", "0.3,30"])]
+    config = yaml.safe_load(Path(args.config).read_text())
+    suffix = f"_h{args.size_um:g}"
+    runs = {rid: d for rid, d in matrix.all_runs(config).items()
+            if rid.endswith(suffix) and re.search(args.match, rid)}
+    out = Path(args.out or ROOT / "benchmarks" / "results" / f"load_control_h{args.size_um:g}.json")
+    result: dict[str, object] = {"config": args.config, "size_um": args.size_um, "settings": settings, "runs": {}}
+    if args.trace:
+        set_controller(*settings[0])
+        result["trace"] = {args.trace: trace(Scene.from_dict(matrix.all_runs(config)[args.trace]))}
+        print(json.dumps(result["trace"], indent=1))
+    for rid, scene_dict in runs.items():
+        scene = Scene.from_dict(scene_dict)
+        rows = {}
+        for sf, steps in settings:
+            set_controller(sf, steps)
+            rows[f"{sf:g},{steps:g}"] = measure(scene)
+        result["runs"][rid] = rows
+        print(rid, " | ".join(f"{k}: Fz/load {r['fz_over_load']:.4f} mu {r['mu']:.4f} dp {r['dp_um']:.2f}"
+                              for k, r in rows.items()), flush=True)
+        out.write_text(json.dumps(result, indent=1))  # kept as it goes: a long sweep can be stopped
+    summary = {}
+    for sf, steps in settings:
+        key = f"{sf:g},{steps:g}"
+        miss = [r[key]["fz_over_load"] - 1.0 for r in result["runs"].values()]
+        summary[key] = {"runs": len(miss), "within_1pct": sum(abs(m) <= 0.01 for m in miss),
+                        "largest_miss": max(miss, key=abs) if miss else None,
+                        "steady": sum(r[key]["steady"] for r in result["runs"].values())}
+    if len(settings) > 1 and result["runs"]:
+        base, other = (f"{sf:g},{steps:g}" for sf, steps in settings[:2])
+        for q in ("mu", "dp_um"):
+            change = [r[other][q] / r[base][q] - 1.0 for r in result["runs"].values() if r[base][q] > 0.0]
+            summary[f"{q}_change_{other}_vs_{base}"] = {"median": statistics.median(change), "min": min(change),
+                                                        "max": max(change)}
+    result["summary"] = summary
+    out.write_text(json.dumps(result, indent=1))
+    print(json.dumps(summary, indent=1))
+
+
+if __name__ == "__main__":
+    main()
