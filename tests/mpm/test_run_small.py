@@ -362,15 +362,21 @@ def test_a_particle_flung_past_the_far_end_flies_on_over_the_lengthened_grid(tin
     assert p.v[i, 0] == pytest.approx(v0, rel=1e-6) and abs(p.v[i, 2]) < 1e-6 * v0
 
 
+def _growth_peak_bytes(state, shape, extra, axis):
+    """The memory a growth by ``extra`` layers along ``axis`` should count, written out: the run's arrays, plus
+    the added layers of every per-node array or the new per-chunk P2G buffers beside the old, whichever is more."""
+    w = state.work
+    held = solver._array_bytes(state.particles) + solver._array_bytes(w)
+    per_layer = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push,
+                                       w.flags)) // shape[axis]
+    return held + max(per_layer * extra, w.grid_buf.nbytes // shape[axis] * (shape[axis] + extra))
+
+
 def test_a_lengthening_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(tiny_scene, monkeypatch):
     state, const = solver.init(tiny_scene, n_chunks=2)
     shape = const.grid.shape
-    held = solver._array_bytes(state.particles) + solver._array_bytes(state.work)
-    w = state.work
-    per_layer = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push,
-                                       w.flags)) // shape[0]
     for extra in (1, 4, shape[0]):
-        peak = held + max(per_layer * extra, w.grid_buf.nbytes // shape[0] * (shape[0] + extra))
+        peak = _growth_peak_bytes(state, shape, extra, axis=0)
         assert solver.raise_bytes(state, shape, extra, axis=0) == peak
         with pytest.raises(solver.InstabilityError, match=rf"passed the grid's far end, and lengthening it by {extra} "
                                                           "node layers would hold"):
@@ -380,6 +386,17 @@ def test_a_lengthening_that_would_not_fit_in_memory_stops_the_run_naming_the_mem
     monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need)
     solver.check_stability(state, const)
     assert const.grid.shape[0] == shape[0] + 2 and len(state.grid_extensions) == 1
+
+
+def _assert_same_run(a, b, scene):
+    """Two states of one scene hold the same particles, sphere and contact forces (to round-off), and they
+    moved: a growth that scrambled the contact memory or the grid would not match."""
+    for name in ("x", "v", "stress", "eps_p", "J"):
+        np.testing.assert_allclose(getattr(a.particles, name), getattr(b.particles, name),
+                                   rtol=1e-12, atol=1e-300, err_msg=name)
+    np.testing.assert_allclose(a.sphere.centre, b.sphere.centre, rtol=1e-12)
+    np.testing.assert_allclose(a.work.contact_out, b.work.contact_out, rtol=1e-10, atol=1e-18)
+    assert np.abs(a.particles.x - solver.init(scene, n_chunks=1)[0].particles.x).max() > 1e-7
 
 
 @pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])
@@ -402,12 +419,7 @@ def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_lon
     assert start.step == late.step
     assert late.zone.n_hi == start.zone.n_hi == c_late.grid.n_nodes
     assert late.zone.check_hi_m[0] == start.zone.check_hi_m[0] == c_late.grid_hi[0]
-    for name in ("x", "v", "stress", "eps_p", "J"):
-        np.testing.assert_allclose(getattr(late.particles, name), getattr(start.particles, name),
-                                   rtol=1e-12, atol=1e-300, err_msg=name)
-    np.testing.assert_allclose(late.sphere.centre, start.sphere.centre, rtol=1e-12)
-    np.testing.assert_allclose(late.work.contact_out, start.work.contact_out, rtol=1e-10, atol=1e-18)
-    assert np.abs(late.particles.x - solver.init(scene, n_chunks=1)[0].particles.x).max() > 1e-7
+    _assert_same_run(late, start, scene)
 
 
 def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
@@ -467,12 +479,8 @@ def test_a_raise_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(ti
     doubled room does not fit but the room the particle needs does, the top rises by that much."""
     state, const = solver.init(tiny_scene, n_chunks=2)
     shape = const.grid.shape
-    held = solver._array_bytes(state.particles) + solver._array_bytes(state.work)
-    w = state.work
-    per_layer = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push,
-                                       w.flags)) // shape[2]
     for extra in (1, 3, shape[2]):
-        peak = held + max(per_layer * extra, w.grid_buf.nbytes // shape[2] * (shape[2] + extra))
+        peak = _growth_peak_bytes(state, shape, extra, axis=2)
         assert solver.raise_bytes(state, shape, extra) == peak
         solver.check_raise_memory(state, shape, extra, peak)
         with pytest.raises(solver.InstabilityError, match=rf"raising it by {extra} node layers would hold"):
@@ -511,13 +519,7 @@ def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_tal
         solver.step(raised_late, c_late)
     assert from_start.step == raised_late.step and raised_late.sphere.slid_m > 10e-6
     assert (raised_late.zone.p_hi - raised_late.zone.p_lo < raised_late.particles.n) == (zone is not None)
-    for name in ("x", "v", "stress", "eps_p", "J"):
-        np.testing.assert_allclose(getattr(raised_late.particles, name), getattr(from_start.particles, name),
-                                   rtol=1e-12, atol=1e-300, err_msg=name)
-    np.testing.assert_allclose(raised_late.sphere.centre, from_start.sphere.centre, rtol=1e-12)
-    np.testing.assert_allclose(raised_late.work.contact_out, from_start.work.contact_out, rtol=1e-10, atol=1e-18)
-    # and it moved: a raise that scrambled the contact memory or the grid would not match
-    assert np.abs(raised_late.particles.x - solver.init(scene, n_chunks=1)[0].particles.x).max() > 1e-7
+    _assert_same_run(raised_late, from_start, scene)
 
 
 def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatch, capsys):

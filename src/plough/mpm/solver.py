@@ -542,14 +542,10 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     """
     if c.grid_top_limit_m <= 0.0:
         return False
-    z = s.zone
-    top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
-    now = float(c.grid_hi[2])
-    # node layers to add: needed by the highest particle, wanted (the room doubled), allowed (the limit)
-    need = math.ceil((top + c.grid.dx - now) / c.grid.dx - 1e-9)
-    wanted = math.ceil((max(2.0 * now, top + c.grid.dx) - now) / c.grid.dx - 1e-9)
-    allowed = math.floor((c.grid_top_limit_m - now) / c.grid.dx + 1e-9)
-    if not _grow_within(s, c, 2, need, wanted, allowed):
+    top = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 2].max())
+    # room for the highest particle, wanted: the room doubled
+    if not _grow_within(s, c, 2, top + c.grid.dx, max(2.0 * float(c.grid_hi[2]), top + c.grid.dx),
+                        c.grid_top_limit_m):
         return False
     s.grid_raises.append((s.step, s.sphere.slid_m, float(c.grid_hi[2])))
     return True
@@ -567,21 +563,21 @@ def lengthen_grid(s: State, c: Constants) -> bool:
     """
     if c.grid_end_limit_m <= 0.0:
         return False
-    z = s.zone
-    far = float(s.particles.x[z.p_lo:z.p_hi, 0].max())
-    now = float(c.grid_hi[0])
-    need = math.ceil((far + c.grid.dx - now) / c.grid.dx - 1e-9)
-    wanted = math.ceil((far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius - now) / c.grid.dx - 1e-9)
-    allowed = math.floor((c.grid_end_limit_m - now) / c.grid.dx + 1e-9)
-    if not _grow_within(s, c, 0, need, wanted, allowed):
+    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 0].max())
+    if not _grow_within(s, c, 0, far + c.grid.dx, far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius,
+                        c.grid_end_limit_m):
         return False
     s.grid_extensions.append((s.step, s.sphere.slid_m, float(c.grid_hi[0])))
     return True
 
 
-def _grow_within(s: State, c: Constants, axis: int, need: int, wanted: int, allowed: int) -> bool:
-    """Grow the grid along ``axis`` by the ``wanted`` node layers, or fewer down to the ``need``ed ones where
-    the limit (``allowed``) or the memory says so; False, nothing grown, where even those pass the limit."""
+def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float, limit_m: float) -> bool:
+    """Grow the grid's interior along ``axis`` to ``want_m``, or less, down to ``need_m``, where the limit
+    (``limit_m``) or the memory says so; False, nothing grown, where even ``need_m`` passes the limit."""
+    now, dx = float(c.grid_hi[axis]), c.grid.dx
+    need = math.ceil((need_m - now) / dx - 1e-9)  # whole node layers
+    wanted = math.ceil((want_m - now) / dx - 1e-9)
+    allowed = math.floor((limit_m - now) / dx + 1e-9)
     extra = min(wanted, allowed)
     if extra < max(need, 1):
         return False
