@@ -245,12 +245,18 @@ def test_check_stability_names_step_sliding_distance_and_cause(tiny_state, code)
     solver.check_stability(state, const)
 
 
-def _flag_above_the_top(state, const, index=5, over_m=None):
-    """Mark particle ``index`` as having risen ``over_m`` (default a tenth of a cell) above the grid's top."""
+def _flag_outside(state, const, index, axis, over_m):
+    """Mark particle ``index`` as having left the grid ``over_m`` past its high face along ``axis``, as the
+    G2P kernel reports it."""
     state.work.acc[:] = 0.0
     state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
     state.work.acc[0, transfers.ACC_BAD_INDEX] = index
-    state.particles.x[index, 2] = const.grid_hi[2] + (0.1 * const.grid.dx if over_m is None else over_m)
+    state.particles.x[index, axis] = const.grid_hi[axis] + over_m
+
+
+def _flag_above_the_top(state, const, index=5, over_m=None):
+    """Particle ``index`` risen ``over_m`` (default a tenth of a cell) above the grid's top."""
+    _flag_outside(state, const, index, 2, 0.1 * const.grid.dx if over_m is None else over_m)
 
 
 def test_a_particle_above_a_hand_set_grid_top_is_named_a_prow_and_points_at_the_headroom(tiny_scene):
@@ -268,11 +274,8 @@ def test_a_particle_above_a_hand_set_grid_top_is_named_a_prow_and_points_at_the_
 
 
 def _flag_past_the_end(state, const, index=7, over_m=None):
-    """Mark particle ``index`` as having moved ``over_m`` (default a fifth of a cell) past the grid's far end."""
-    state.work.acc[:] = 0.0
-    state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
-    state.work.acc[0, transfers.ACC_BAD_INDEX] = index
-    state.particles.x[index, 0] = const.grid_hi[0] + (0.2 * const.grid.dx if over_m is None else over_m)
+    """Particle ``index`` moved ``over_m`` (default a fifth of a cell) past the grid's far end."""
+    _flag_outside(state, const, index, 0, 0.2 * const.grid.dx if over_m is None else over_m)
 
 
 def test_a_particle_past_a_fixed_grids_far_end_is_named_material_pushed_ahead(tiny_scene):
