@@ -75,6 +75,27 @@ def trace(scene: Scene) -> dict[str, float]:
             "mean_filtered_error_N": scene.load_N - float(np.mean(filtered)), "load_N": scene.load_N}
 
 
+def summarise(runs: dict[str, dict[str, dict[str, float]]], settings: list[tuple[float, ...]]) -> dict[str, object]:
+    """Per setting: runs within 1% of the load, the largest and the median miss, steady windows; and the
+    changes in mu and dp of the second setting against the first (median, median magnitude, range)."""
+    keys = [f"{sf:g},{steps:g}" for sf, steps in settings]
+    summary: dict[str, object] = {}
+    for key in keys:
+        miss = [r[key]["fz_over_load"] - 1.0 for r in runs.values()]
+        summary[key] = {"runs": len(miss), "within_1pct": sum(abs(m) <= 0.01 for m in miss),
+                        "largest_miss": max(miss, key=abs) if miss else None,
+                        "median_abs_miss": statistics.median(abs(m) for m in miss) if miss else None,
+                        "steady": sum(r[key]["steady"] for r in runs.values())}
+    if len(keys) > 1 and runs:
+        base, other = keys[:2]
+        for q in ("mu", "dp_um"):
+            change = [r[other][q] / r[base][q] - 1.0 for r in runs.values() if r[base][q] > 0.0]
+            summary[f"{q}_change_{other}_vs_{base}"] = {
+                "median": statistics.median(change), "median_abs": statistics.median(abs(c) for c in change),
+                "min": min(change), "max": max(change)}
+    return summary
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", default=str(ROOT / "config" / "preview.yaml"))
@@ -106,20 +127,7 @@ def main() -> None:
         print(rid, " | ".join(f"{k}: Fz/load {r['fz_over_load']:.4f} mu {r['mu']:.4f} dp {r['dp_um']:.2f}"
                               for k, r in rows.items()), flush=True)
         out.write_text(json.dumps(result, indent=1))  # kept as it goes: a long sweep can be stopped
-    summary = {}
-    for sf, steps in settings:
-        key = f"{sf:g},{steps:g}"
-        miss = [r[key]["fz_over_load"] - 1.0 for r in result["runs"].values()]
-        summary[key] = {"runs": len(miss), "within_1pct": sum(abs(m) <= 0.01 for m in miss),
-                        "largest_miss": max(miss, key=abs) if miss else None,
-                        "steady": sum(r[key]["steady"] for r in result["runs"].values())}
-    if len(settings) > 1 and result["runs"]:
-        base, other = (f"{sf:g},{steps:g}" for sf, steps in settings[:2])
-        for q in ("mu", "dp_um"):
-            change = [r[other][q] / r[base][q] - 1.0 for r in result["runs"].values() if r[base][q] > 0.0]
-            summary[f"{q}_change_{other}_vs_{base}"] = {"median": statistics.median(change), "min": min(change),
-                                                        "max": max(change)}
-    result["summary"] = summary
+    result["summary"] = summary = summarise(result["runs"], settings)
     out.write_text(json.dumps(result, indent=1))
     print(json.dumps(summary, indent=1))
 
