@@ -2,6 +2,7 @@
 
     python benchmarks/load_control.py [--config config/preview.yaml] [--size-um 20] [--match REGEX]
         [--setting 1,100] [--setting 0.3,30] [--trace RUN] [--out FILE]
+    python benchmarks/load_control.py --extrapolate FILE FILE [FILE ...] [--out FILE]
 
 For every MPM run of the config at one particle size (optionally those whose id matches ``--match``), each
 ``--setting`` ``STIFFNESS_FACTOR,INTEGRAL_STEPS`` of ``plough.mpm.solver`` (the gain from the elastic contact
@@ -14,6 +15,12 @@ integrates the filtered error on every unbounded step), which says where a misse
 
 Writes ``--out`` (default benchmarks/results/load_control_h<size>.json) and prints a table and a summary
 (runs within 1% of the load, the largest miss, the changes in mu and dp between the settings).
+
+With ``--extrapolate`` no run is made: the results files of several particle sizes (this script's own, with the
+same settings) are read, every point present at two or more sizes is extrapolated to h -> 0 in mu and dp for each
+setting (``plough.study.extrapolation.extrapolate``, as the workflow does), and the change the second setting
+makes to the extrapolated value is set against the two values' combined uncertainty: a controller whose change
+stays inside it leaves the h -> 0 results where they were, whatever it does at one size.
 """
 
 from __future__ import annotations
@@ -33,6 +40,7 @@ from plough.mpm import solver
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 from plough.study import matrix
+from plough.study.extrapolation import extrapolate
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -96,6 +104,58 @@ def summarise(runs: dict[str, dict[str, dict[str, float]]], settings: list[tuple
     return summary
 
 
+def extrapolated(files: list[Path]) -> dict[str, object]:
+    """Per point (run id without its size) and setting: mu and dp at each size and their h -> 0 values with
+    uncertainty; and the second setting's change to those values against their combined uncertainty."""
+    by_point: dict[str, dict[float, dict[str, dict[str, float]]]] = {}
+    keys: list[str] = []
+    for f in files:
+        data = json.loads(Path(f).read_text())
+        file_keys = [f"{sf:g},{steps:g}" for sf, steps in data["settings"]]
+        keys = keys or file_keys
+        if file_keys[: len(keys)] != keys:
+            raise SystemExit(f"{f}: settings {file_keys} differ from the first file's {keys}")
+        for rid, rows in data["runs"].items():
+            point, _, size = rid.rpartition("_h")
+            by_point.setdefault(point, {})[float(size)] = rows
+    points: dict[str, object] = {}
+    for point, sizes in sorted(by_point.items()):
+        if len(sizes) < 2:
+            continue
+        h = sorted(sizes)
+        entry: dict[str, object] = {"h_um": h}
+        for q in ("mu", "dp_um"):
+            per_setting = {}
+            for key in keys:
+                values = [sizes[hh][key][q] for hh in h]
+                e = extrapolate(h, values)
+                per_setting[key] = {"values": values, "h0": float(e.value), "uncertainty": float(e.uncertainty),
+                                    "order": float(e.order), "flagged": bool(e.flagged)}
+            if len(keys) > 1:
+                a, b = per_setting[keys[0]], per_setting[keys[1]]
+                change = b["h0"] - a["h0"]
+                combined = float(np.hypot(a["uncertainty"], b["uncertainty"]))
+                per_setting["change"] = change
+                per_setting["combined_uncertainty"] = combined
+                per_setting["change_within_uncertainty"] = bool(abs(change) <= combined)
+            entry[q] = per_setting
+        points[point] = entry
+    return {"files": [str(f) for f in files], "settings": keys, "points": points}
+
+
+def print_extrapolated(result: dict[str, object]) -> None:
+    keys = result["settings"]
+    for point, entry in result["points"].items():
+        print(point, "h =", "/".join(f"{h:g}" for h in entry["h_um"]), "um")
+        for q in ("mu", "dp_um"):
+            cells = [f"{k}: " + " ".join(f"{v:.4g}" for v in entry[q][k]["values"])
+                     + f" -> {entry[q][k]['h0']:.4g} +- {entry[q][k]['uncertainty']:.2g}"
+                     + (" (flagged)" if entry[q][k]["flagged"] else "") for k in keys]
+            if "change" in entry[q]:
+                cells.append(f"change {entry[q]['change']:+.4g} vs +-{entry[q]['combined_uncertainty']:.2g}")
+            print(f"  {q:6s}", " | ".join(cells))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--config", default=str(ROOT / "config" / "preview.yaml"))
@@ -104,8 +164,16 @@ def main() -> None:
     parser.add_argument("--setting", action="append", default=None,
                         help="STIFFNESS_FACTOR,INTEGRAL_STEPS (repeatable; default 1,100 and 0.3,30)")
     parser.add_argument("--trace", default=None, help="a run id to trace the controller's integral in")
+    parser.add_argument("--extrapolate", nargs="+", type=Path, default=None,
+                        help="results files of several sizes: extrapolate them instead of running")
     parser.add_argument("--out", default=None)
     args = parser.parse_args()
+    if args.extrapolate:
+        result = extrapolated(args.extrapolate)
+        print_extrapolated(result)
+        if args.out:
+            Path(args.out).write_text(json.dumps(result, indent=1))
+        return
     settings = [tuple(float(v) for v in s.split(",")) for s in (args.setting or ["1,100", "0.3,30"])]
     config = yaml.safe_load(Path(args.config).read_text())
     suffix = f"_h{args.size_um:g}"
