@@ -391,6 +391,52 @@ def test_a_lengthening_that_would_not_fit_in_memory_stops_the_run_naming_the_mem
     assert const.grid.shape[0] == shape[0] + 2 and len(state.grid_extensions) == 1
 
 
+def test_a_raise_and_a_lengthening_on_one_step_share_the_memory(tiny_scene, monkeypatch):
+    """Memory for the two needed growths, not for the doubled top and then the lengthening: the top rises by
+    the room its particle needs and the grid still lengthens, where sizing the raise alone (the doubled room
+    fits by itself) would leave too little for the lengthening and stop the run."""
+    state, const = solver.init(tiny_scene, n_chunks=2)
+    shape = const.grid.shape
+    _flag_past_the_end(state, const)  # needs 2 x layers
+    state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * const.grid.dx  # needs 2 z layers; doubling wants more
+    assert solver._layers_past_end(state, const) == 2
+    wanted = math.ceil(const.grid_hi[2] / const.grid.dx - 1e-9)
+    assert wanted > 2
+    both_needed = solver.growth_bytes(state, shape, [(2, 2), (0, 2)])
+    assert solver.raise_bytes(state, shape, wanted) <= both_needed  # the doubled room alone would fit
+    assert solver.growth_bytes(state, shape, [(2, wanted), (0, 2)]) > both_needed  # but not with the lengthening
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: both_needed)
+    solver.check_stability(state, const)
+    assert const.grid.shape == (shape[0] + 2, shape[1], shape[2] + 2)
+    assert len(state.grid_raises) == len(state.grid_extensions) == 1 and solver._outside_index(state) == -1
+    # with memory for the doubled top and the needed lengthening the top doubles (the lengthening then takes
+    # what room it wants within what is left)
+    state2, const2 = solver.init(tiny_scene, n_chunks=2)
+    _flag_past_the_end(state2, const2)
+    state2.particles.x[5, 2] = const2.grid_hi[2] + 0.1 * const2.grid.dx
+    monkeypatch.setattr(solver, "physical_memory_bytes",
+                        lambda: solver.growth_bytes(state2, shape, [(2, wanted), (0, 2)]))
+    solver.check_stability(state2, const2)
+    assert const2.grid.shape[2] == shape[2] + wanted and const2.grid.shape[0] >= shape[0] + 2
+    assert len(state2.grid_raises) == len(state2.grid_extensions) == 1 and solver._outside_index(state2) == -1
+
+
+def test_growth_bytes_counts_growths_in_turn(tiny_scene):
+    """Two growths: the second counted on the grid the first left (its layers larger by the first's), and the
+    peak the larger of the two steps'; one growth is raise_bytes."""
+    state, const = solver.init(tiny_scene, n_chunks=2)
+    shape = const.grid.shape
+    w = state.work
+    node = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push, w.flags))
+    held = solver._array_bytes(state.particles) + solver._array_bytes(w)
+    first = _growth_peak_bytes(state, shape, 3, axis=2)
+    added = node * 3 // shape[2]
+    buf2 = w.grid_buf.nbytes * (shape[2] + 3) // shape[2]
+    second = held + added + max((node + added) * 4 // shape[0], buf2 * (shape[0] + 4) // shape[0])
+    assert solver.growth_bytes(state, shape, [(2, 3), (0, 4)]) == max(first, second) == second
+    assert solver.growth_bytes(state, shape, [(0, 4)]) == solver.raise_bytes(state, shape, 4, axis=0)
+
+
 def _assert_same_run(a, b, scene):
     """Two states of one scene hold the same particles, sphere and contact forces (to round-off), and they
     moved: a growth that scrambled the contact memory or the grid would not match."""

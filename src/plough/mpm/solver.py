@@ -519,25 +519,40 @@ def check_stability(s: State, c: Constants) -> None:
 
 def _grow_to_hold(s: State, c: Constants, index: int) -> int:
     """Raise the grid's top and lengthen it past the far end as far as the particles outside need and the
-    limits allow; the particle still outside afterwards (``index`` where nothing grew), -1 if none."""
-    x = s.particles.x
-    if x[index, 2] > c.grid_hi[2] and raise_grid_top(s, c):
+    limits allow; the particle still outside afterwards (``index`` where nothing grew), -1 if none.
+
+    Both are sized on this step's particles before either grows: the raise first, its wanted room counted
+    against the memory together with the lengthening that follows (which then checks itself)."""
+    z = s.zone
+    top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
+    lengthen = _layers_past_end(s, c)
+    if top > c.grid_hi[2] and raise_grid_top(s, c, then=(0, lengthen) if lengthen else None):
         index = _outside_index(s)
-    if index >= 0 and x[index, 0] > c.grid_hi[0] and lengthen_grid(s, c):
-        index = _outside_index(s)
-    if index >= 0 and x[index, 2] > c.grid_hi[2] and raise_grid_top(s, c):  # another above the top, found now
+    if index >= 0 and lengthen and lengthen_grid(s, c):
         index = _outside_index(s)
     return index
 
 
-def raise_grid_top(s: State, c: Constants) -> bool:
+def _layers_past_end(s: State, c: Constants) -> int:
+    """Node layers a lengthening needs for the active particles past the grid's far end (one cell past the
+    farthest), 0 where none is past it or the grid cannot lengthen."""
+    if c.grid_end_limit_m <= 0.0:
+        return 0
+    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 0].max())
+    if far <= c.grid_hi[0]:
+        return 0
+    return max(math.ceil((far + c.grid.dx - float(c.grid_hi[0])) / c.grid.dx - 1e-9), 1)
+
+
+def raise_grid_top(s: State, c: Constants, then: tuple[int, int] | None = None) -> bool:
     """Raise the grid's top mid-run so that every active particle has room again; False where the
     scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``; stops the run
     (:func:`check_raise_memory`) where even the room the particles need would not fit in memory.
 
     The room above the surface at least doubles (a few raises cover any prow; only the room needed
-    where the doubled one would not fit in memory), one cell above the highest particle at least,
-    and stops at the limit. The new layers' flags are those of the old top layer (above the surface
+    where the doubled one, followed by the growth ``then`` (axis, node layers) the same step makes
+    next, would not fit in memory), one cell above the highest particle at least, and stops at the
+    limit. The new layers' flags are those of the old top layer (above the surface
     they depend on y alone); see :func:`grow_grid`.
     """
     if c.grid_top_limit_m <= 0.0:
@@ -545,7 +560,7 @@ def raise_grid_top(s: State, c: Constants) -> bool:
     top = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 2].max())
     # room for the highest particle, wanted: the room doubled
     if not _grow_within(s, c, 2, top + c.grid.dx, max(2.0 * float(c.grid_hi[2]), top + c.grid.dx),
-                        c.grid_top_limit_m):
+                        c.grid_top_limit_m, then):
         return False
     s.grid_raises.append((s.step, s.sphere.slid_m, float(c.grid_hi[2])))
     return True
@@ -571,9 +586,12 @@ def lengthen_grid(s: State, c: Constants) -> bool:
     return True
 
 
-def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float, limit_m: float) -> bool:
+def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float, limit_m: float,
+                 then: tuple[int, int] | None = None) -> bool:
     """Grow the grid's interior along ``axis`` to ``want_m``, or less, down to ``need_m``, where the limit
-    (``limit_m``) or the memory says so; False, nothing grown, where even ``need_m`` passes the limit."""
+    (``limit_m``) or the memory says so; False, nothing grown, where even ``need_m`` passes the limit. The
+    wanted room counts, against the memory, the growth ``then`` (axis, node layers) that follows it on the same
+    step; the needed room is checked alone (the growth that follows checks itself)."""
     now, dx = float(c.grid_hi[axis]), c.grid.dx
     need = math.ceil((need_m - now) / dx - 1e-9)  # whole node layers
     wanted = math.ceil((want_m - now) / dx - 1e-9)
@@ -582,7 +600,8 @@ def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float
     if extra < max(need, 1):
         return False
     available = physical_memory_bytes()
-    if available is not None and raise_bytes(s, c.grid.shape, extra, axis) > available and extra > max(need, 1):
+    growths = [(axis, extra), *([then] if then else [])]
+    if available is not None and growth_bytes(s, c.grid.shape, growths) > available and extra > max(need, 1):
         extra = max(need, 1)  # the wanted room does not fit in memory: the room the particles need
     check_raise_memory(s, c.grid.shape, extra, available, axis)
     grow_grid(s, c, axis, extra)
@@ -628,11 +647,24 @@ def raise_bytes(s: State, shape: tuple[int, int, int], extra: int, axis: int = 2
     """Bytes the run holds at the peak of growing the grid by ``extra`` node layers along ``axis``: its
     particle and per-node arrays, plus the layers added, or the new per-chunk P2G buffers while the old ones
     are still held (most of a run's node memory), whichever is more."""
-    node_arrays = (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div, s.work.cbuf,
-                   s.work.last_push, s.work.flags)
-    added = sum(a.nbytes for a in node_arrays) * extra // shape[axis]  # one layer is 1 / shape[axis] of the nodes
-    new_buffers = s.work.grid_buf.nbytes * (shape[axis] + extra) // shape[axis]
-    return _array_bytes(s.particles) + _array_bytes(s.work) + max(added, new_buffers)
+    return growth_bytes(s, shape, [(axis, extra)])
+
+
+def growth_bytes(s: State, shape: tuple[int, int, int], growths: list[tuple[int, int]]) -> int:
+    """Bytes the run holds at the peak of growing the grid by each ``(axis, node layers)`` of ``growths`` in
+    turn (:func:`raise_bytes` for each, on the grid the ones before it left)."""
+    node = sum(a.nbytes for a in (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div, s.work.cbuf,
+                                  s.work.last_push, s.work.flags))
+    buffers = s.work.grid_buf.nbytes
+    held = _array_bytes(s.particles) + _array_bytes(s.work)
+    peak, dims = held, list(shape)
+    for axis, extra in growths:
+        added = node * extra // dims[axis]  # one layer is 1 / dims[axis] of the nodes
+        new_buffers = buffers * (dims[axis] + extra) // dims[axis]
+        peak = max(peak, held + max(added, new_buffers))
+        held, node, buffers = held + added, node + added, new_buffers
+        dims[axis] += extra
+    return peak
 
 
 def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None,
