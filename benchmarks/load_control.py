@@ -17,10 +17,11 @@ Writes ``--out`` (default benchmarks/results/load_control_h<size>.json) and prin
 (runs within 1% of the load, the largest miss, the changes in mu and dp between the settings).
 
 With ``--extrapolate`` no run is made: the results files of several particle sizes (this script's own, with the
-same settings) are read, every point present at two or more sizes is extrapolated to h -> 0 in mu and dp for each
-setting (``plough.study.extrapolation.extrapolate``, as the workflow does), and the change the second setting
-makes to the extrapolated value is set against the two values' combined uncertainty: a controller whose change
-stays inside it leaves the h -> 0 results where they were, whatever it does at one size.
+same settings, one file per size) are read, every point present at two or more sizes is extrapolated to h -> 0 in
+mu and dp for each setting (``plough.study.extrapolation.extrapolate``, the workflow's extrapolation, without its
+sampling error), and so is the change the second setting makes at each size, with its own uncertainty: a
+controller whose extrapolated change lies inside that uncertainty leaves the h -> 0 results where they were,
+whatever it does at one size.
 """
 
 from __future__ import annotations
@@ -106,18 +107,27 @@ def summarise(runs: dict[str, dict[str, dict[str, float]]], settings: list[tuple
 
 def extrapolated(files: list[Path]) -> dict[str, object]:
     """Per point (run id without its size) and setting: mu and dp at each size and their h -> 0 values with
-    uncertainty; and the second setting's change to those values against their combined uncertainty."""
+    uncertainty; and the second setting's change to them, extrapolated itself from the per-size differences
+    (the two settings share a point's discretisation error, so the difference is extrapolated rather than the
+    two uncertainties added), with its uncertainty."""
     by_point: dict[str, dict[float, dict[str, dict[str, float]]]] = {}
-    keys: list[str] = []
+    keys: list[str] | None = None
+    seen: dict[float, Path] = {}
     for f in files:
         data = json.loads(Path(f).read_text())
         file_keys = [f"{sf:g},{steps:g}" for sf, steps in data["settings"]]
-        keys = keys or file_keys
-        if file_keys[: len(keys)] != keys:
-            raise SystemExit(f"{f}: settings {file_keys} differ from the first file's {keys}")
+        if keys is not None and file_keys != keys:
+            raise SystemExit(f"{f}: settings {file_keys} differ from {files[0]}'s {keys}")
+        keys = file_keys
+        size = float(data["size_um"])
+        if size in seen:
+            raise SystemExit(f"{f} and {seen[size]} are both of h = {size:g} um: merge them into one file")
+        seen[size] = f
+        suffix = f"_h{size:g}"
         for rid, rows in data["runs"].items():
-            point, _, size = rid.rpartition("_h")
-            by_point.setdefault(point, {})[float(size)] = rows
+            if not rid.endswith(suffix):
+                raise SystemExit(f"{f}: run {rid} is not of the file's size h = {size:g} um")
+            by_point.setdefault(rid[: -len(suffix)], {})[size] = rows
     points: dict[str, object] = {}
     for point, sizes in sorted(by_point.items()):
         if len(sizes) < 2:
@@ -125,22 +135,24 @@ def extrapolated(files: list[Path]) -> dict[str, object]:
         h = sorted(sizes)
         entry: dict[str, object] = {"h_um": h}
         for q in ("mu", "dp_um"):
-            per_setting = {}
+            per_setting: dict[str, object] = {}
             for key in keys:
                 values = [sizes[hh][key][q] for hh in h]
-                e = extrapolate(h, values)
-                per_setting[key] = {"values": values, "h0": float(e.value), "uncertainty": float(e.uncertainty),
-                                    "order": float(e.order), "flagged": bool(e.flagged)}
+                per_setting[key] = _extrapolated_entry(h, values)
             if len(keys) > 1:
-                a, b = per_setting[keys[0]], per_setting[keys[1]]
-                change = b["h0"] - a["h0"]
-                combined = float(np.hypot(a["uncertainty"], b["uncertainty"]))
+                difference = [sizes[hh][keys[1]][q] - sizes[hh][keys[0]][q] for hh in h]
+                change = _extrapolated_entry(h, difference)
+                change["outside_uncertainty"] = bool(abs(change["h0"]) > change["uncertainty"])
                 per_setting["change"] = change
-                per_setting["combined_uncertainty"] = combined
-                per_setting["change_within_uncertainty"] = bool(abs(change) <= combined)
             entry[q] = per_setting
         points[point] = entry
     return {"files": [str(f) for f in files], "settings": keys, "points": points}
+
+
+def _extrapolated_entry(h: list[float], values: list[float]) -> dict[str, object]:
+    e = extrapolate(h, values)
+    return {"values": values, "h0": float(e.value), "uncertainty": float(e.uncertainty), "order": float(e.order),
+            "flagged": bool(e.flagged)}
 
 
 def print_extrapolated(result: dict[str, object]) -> None:
@@ -152,7 +164,9 @@ def print_extrapolated(result: dict[str, object]) -> None:
                      + f" -> {entry[q][k]['h0']:.4g} +- {entry[q][k]['uncertainty']:.2g}"
                      + (" (flagged)" if entry[q][k]["flagged"] else "") for k in keys]
             if "change" in entry[q]:
-                cells.append(f"change {entry[q]['change']:+.4g} vs +-{entry[q]['combined_uncertainty']:.2g}")
+                ch = entry[q]["change"]
+                cells.append(f"change {ch['h0']:+.4g} +- {ch['uncertainty']:.2g}" + (" (flagged)" if ch["flagged"]
+                                                                                     else ""))
             print(f"  {q:6s}", " | ".join(cells))
 
 

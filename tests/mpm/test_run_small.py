@@ -405,10 +405,22 @@ def test_a_raise_and_a_lengthening_on_one_step_share_the_memory(tiny_scene, monk
     both_needed = solver.growth_bytes(state, shape, [(2, 2), (0, 2)])
     assert solver.raise_bytes(state, shape, wanted) <= both_needed  # the doubled room alone would fit
     assert solver.growth_bytes(state, shape, [(2, wanted), (0, 2)]) > both_needed  # but not with the lengthening
+    # a byte less: the run stops before either grows, naming both
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: both_needed - 1)
+    with pytest.raises(solver.InstabilityError, match=r"raising it by 2 node layers and then lengthening it by 2 "
+                                                      "would hold"):
+        solver.check_stability(state, const)
+    assert const.grid.shape == shape and not state.grid_raises and not state.grid_extensions
     monkeypatch.setattr(solver, "physical_memory_bytes", lambda: both_needed)
     solver.check_stability(state, const)
     assert const.grid.shape == (shape[0] + 2, shape[1], shape[2] + 2)
     assert len(state.grid_raises) == len(state.grid_extensions) == 1 and solver._outside_index(state) == -1
+    # the same whichever of the two particles the kernel flagged
+    state1, const1 = solver.init(tiny_scene, n_chunks=2)
+    _flag_above_the_top(state1, const1)
+    state1.particles.x[7, 0] = const1.grid_hi[0] + 0.2 * const1.grid.dx
+    solver.check_stability(state1, const1)
+    assert const1.grid.shape == (shape[0] + 2, shape[1], shape[2] + 2)
     # with memory for the doubled top and the needed lengthening the top doubles (the lengthening then takes
     # what room it wants within what is left)
     state2, const2 = solver.init(tiny_scene, n_chunks=2)
@@ -421,20 +433,31 @@ def test_a_raise_and_a_lengthening_on_one_step_share_the_memory(tiny_scene, monk
     assert len(state2.grid_raises) == len(state2.grid_extensions) == 1 and solver._outside_index(state2) == -1
 
 
-def test_growth_bytes_counts_growths_in_turn(tiny_scene):
-    """Two growths: the second counted on the grid the first left (its layers larger by the first's), and the
-    peak the larger of the two steps'; one growth is raise_bytes."""
+def test_growth_bytes_counts_growths_in_turn_as_the_grid_really_grows(tiny_scene):
+    """Two growths counted in turn: the peak is the larger of the first growth's and the second's counted on the
+    arrays the first really left; each growth adds exactly its layers of every per-node array."""
     state, const = solver.init(tiny_scene, n_chunks=2)
     shape = const.grid.shape
-    w = state.work
-    node = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push, w.flags))
-    held = solver._array_bytes(state.particles) + solver._array_bytes(w)
-    first = _growth_peak_bytes(state, shape, 3, axis=2)
-    added = node * 3 // shape[2]
-    buf2 = w.grid_buf.nbytes * (shape[2] + 3) // shape[2]
-    second = held + added + max((node + added) * 4 // shape[0], buf2 * (shape[0] + 4) // shape[0])
-    assert solver.growth_bytes(state, shape, [(2, 3), (0, 4)]) == max(first, second) == second
     assert solver.growth_bytes(state, shape, [(0, 4)]) == solver.raise_bytes(state, shape, 4, axis=0)
+    predicted = solver.growth_bytes(state, shape, [(2, 3), (0, 4)])
+    first_peak = solver.raise_bytes(state, shape, 3, axis=2)
+
+    def held():
+        return solver._array_bytes(state.particles) + solver._array_bytes(state.work)
+
+    def node_bytes():
+        w = state.work
+        return sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push, w.flags))
+
+    held0, node0 = held(), node_bytes()
+    solver.grow_grid(state, const, 2, 3)
+    assert held() - held0 == node0 * 3 // shape[2]
+    second_peak = solver.raise_bytes(state, const.grid.shape, 4, axis=0)
+    assert predicted == max(first_peak, second_peak) > solver.raise_bytes(
+        solver.init(tiny_scene, n_chunks=2)[0], shape, 4, axis=0)  # more than the lengthening on the old grid
+    held1, node1 = held(), node_bytes()
+    solver.grow_grid(state, const, 0, 4)
+    assert held() - held1 == node1 * 4 // shape[0]
 
 
 def _assert_same_run(a, b, scene):
@@ -496,6 +519,7 @@ def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     with pytest.raises(solver.InstabilityError, match="particle 9 ") as err:
         solver.check_stability(state2, const2)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value)
+    assert not state2.grid_raises and const2.grid.shape == old_shape  # nothing grown for a run that stops
 
 
 def test_the_automatic_grid_top_stops_at_the_spheres_top(tiny_scene):

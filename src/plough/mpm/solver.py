@@ -522,7 +522,11 @@ def _grow_to_hold(s: State, c: Constants, index: int) -> int:
     limits allow; the particle still outside afterwards (``index`` where nothing grew), -1 if none.
 
     Both are sized on this step's particles before either grows: the raise first, its wanted room counted
-    against the memory together with the lengthening that follows (which then checks itself)."""
+    against the memory together with the lengthening that follows (which then checks itself). Nothing grows
+    where a particle is outside for a reason no growth mends (:func:`_outside_for_good`): the run stops on it."""
+    stuck = _outside_for_good(s, c)
+    if stuck >= 0:
+        return stuck
     z = s.zone
     top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
     lengthen = _layers_past_end(s, c)
@@ -531,6 +535,18 @@ def _grow_to_hold(s: State, c: Constants, index: int) -> int:
     if index >= 0 and lengthen and lengthen_grid(s, c):
         index = _outside_index(s)
     return index
+
+
+def _outside_for_good(s: State, c: Constants) -> int:
+    """An active particle outside the positions check's box other than above the grid's top or past its far
+    end (through the bottom, a side, the near end, or out of the active zone's slabs), -1 if none."""
+    z = s.zone
+    x = s.particles.x[z.p_lo:z.p_hi]
+    low = np.any(x < z.check_lo_m, axis=1)
+    side = x[:, 1] > z.check_hi_m[1]
+    zone = (x[:, 0] > z.check_hi_m[0]) & (x[:, 0] <= c.grid_hi[0])
+    out = np.flatnonzero(low | side | zone)
+    return int(z.p_lo + out[0]) if out.size else -1
 
 
 def _layers_past_end(s: State, c: Constants) -> int:
@@ -590,8 +606,8 @@ def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float
                  then: tuple[int, int] | None = None) -> bool:
     """Grow the grid's interior along ``axis`` to ``want_m``, or less, down to ``need_m``, where the limit
     (``limit_m``) or the memory says so; False, nothing grown, where even ``need_m`` passes the limit. The
-    wanted room counts, against the memory, the growth ``then`` (axis, node layers) that follows it on the same
-    step; the needed room is checked alone (the growth that follows checks itself)."""
+    memory counts the growth ``then`` (axis, node layers) that follows on the same step: the wanted room only
+    where both fit, and where even the needed room and ``then`` do not, the run stops before either grows."""
     now, dx = float(c.grid_hi[axis]), c.grid.dx
     need = math.ceil((need_m - now) / dx - 1e-9)  # whole node layers
     wanted = math.ceil((want_m - now) / dx - 1e-9)
@@ -600,10 +616,9 @@ def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float
     if extra < max(need, 1):
         return False
     available = physical_memory_bytes()
-    growths = [(axis, extra), *([then] if then else [])]
-    if available is not None and growth_bytes(s, c.grid.shape, growths) > available and extra > max(need, 1):
+    if available is not None and growth_bytes(s, c.grid.shape, [(axis, extra), *([then] if then else [])]) > available:
         extra = max(need, 1)  # the wanted room does not fit in memory: the room the particles need
-    check_raise_memory(s, c.grid.shape, extra, available, axis)
+    check_raise_memory(s, c.grid.shape, extra, available, axis, then)
     grow_grid(s, c, axis, extra)
     return True
 
@@ -668,20 +683,21 @@ def growth_bytes(s: State, shape: tuple[int, int, int], growths: list[tuple[int,
 
 
 def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None,
-                       axis: int = 2) -> None:
-    """Stop before growing the grid by ``extra`` node layers along ``axis`` where that would not fit in
-    ``available`` bytes, this machine's physical memory (:func:`raise_bytes`; ``check_memory`` counted the
-    particles alone, before the grid could grow); None: not known, no check. The whole machine's memory:
-    jobs beside the run are not counted."""
+                       axis: int = 2, then: tuple[int, int] | None = None) -> None:
+    """Stop before growing the grid by ``extra`` node layers along ``axis``, and then by ``then`` (axis, node
+    layers) where given, if that would not fit in ``available`` bytes, this machine's physical memory
+    (:func:`growth_bytes`; ``check_memory`` counted the particles alone, before the grid could grow); None:
+    not known, no check. The whole machine's memory: jobs beside the run are not counted."""
     if available is None:
         return
-    peak = raise_bytes(s, shape, extra, axis)
+    peak = growth_bytes(s, shape, [(axis, extra), *([then] if then else [])])
     if peak > available:
         what = ("rose above the grid's top, and raising it" if axis == 2
                 else "passed the grid's far end, and lengthening it")
+        more = f" and then lengthening it by {then[1]}" if then else ""
         raise InstabilityError(
             f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material {what} "
-            f"by {extra} node layers would hold {peak / 2**30:.3g} GiB, more than this machine's "
+            f"by {extra} node layers{more} would hold {peak / 2**30:.3g} GiB, more than this machine's "
             f"{available / 2**30:.3g} GiB of memory (a growing prow or chip: coarser particles, a smaller domain, "
             "or a hand-set domain.headroom_m to stop there)")
 
