@@ -530,7 +530,7 @@ def _grow_to_hold(s: State, c: Constants, index: int) -> int:
     z = s.zone
     top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
     lengthen = _layers_past_end(s, c)
-    if top > c.grid_hi[2] and raise_grid_top(s, c, then=(0, lengthen) if lengthen else None):
+    if top > c.grid_hi[2] and raise_grid_top(s, c, then=((0, lengthen),) if lengthen else ()):
         index = _outside_index(s)
     if index >= 0 and lengthen and lengthen_grid(s, c):
         index = _outside_index(s)
@@ -557,17 +557,22 @@ def _layers_past_end(s: State, c: Constants) -> int:
     far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 0].max())
     if far <= c.grid_hi[0]:
         return 0
-    return max(math.ceil((far + c.grid.dx - float(c.grid_hi[0])) / c.grid.dx - 1e-9), 1)
+    return max(_layers_to(far + c.grid.dx, float(c.grid_hi[0]), c.grid.dx), 1)
 
 
-def raise_grid_top(s: State, c: Constants, then: tuple[int, int] | None = None) -> bool:
+def _layers_to(target_m: float, now_m: float, dx: float) -> int:
+    """Whole node layers that carry the grid's interior from ``now_m`` to ``target_m`` at least."""
+    return math.ceil((target_m - now_m) / dx - 1e-9)
+
+
+def raise_grid_top(s: State, c: Constants, then: tuple[tuple[int, int], ...] = ()) -> bool:
     """Raise the grid's top mid-run so that every active particle has room again; False where the
     scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``; stops the run
     (:func:`check_raise_memory`) where even the room the particles need would not fit in memory.
 
     The room above the surface at least doubles (a few raises cover any prow; only the room needed
-    where the doubled one, followed by the growth ``then`` (axis, node layers) the same step makes
-    next, would not fit in memory), one cell above the highest particle at least, and stops at the
+    where the doubled one, followed by the growths ``then`` ((axis, node layers), ...) the same step
+    makes next, would not fit in memory), one cell above the highest particle at least, and stops at the
     limit. The new layers' flags are those of the old top layer (above the surface
     they depend on y alone); see :func:`grow_grid`.
     """
@@ -603,20 +608,19 @@ def lengthen_grid(s: State, c: Constants) -> bool:
 
 
 def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float, limit_m: float,
-                 then: tuple[int, int] | None = None) -> bool:
+                 then: tuple[tuple[int, int], ...] = ()) -> bool:
     """Grow the grid's interior along ``axis`` to ``want_m``, or less, down to ``need_m``, where the limit
     (``limit_m``) or the memory says so; False, nothing grown, where even ``need_m`` passes the limit. The
-    memory counts the growth ``then`` (axis, node layers) that follows on the same step: the wanted room only
-    where both fit, and where even the needed room and ``then`` do not, the run stops before either grows."""
+    memory counts the growths ``then`` ((axis, node layers), ...) that follow on the same step: the wanted room
+    only where all fit, and where even the needed room and ``then`` do not, the run stops before any grows."""
     now, dx = float(c.grid_hi[axis]), c.grid.dx
-    need = math.ceil((need_m - now) / dx - 1e-9)  # whole node layers
-    wanted = math.ceil((want_m - now) / dx - 1e-9)
+    need, wanted = _layers_to(need_m, now, dx), _layers_to(want_m, now, dx)
     allowed = math.floor((limit_m - now) / dx + 1e-9)
     extra = min(wanted, allowed)
     if extra < max(need, 1):
         return False
     available = physical_memory_bytes()
-    if available is not None and growth_bytes(s, c.grid.shape, [(axis, extra), *([then] if then else [])]) > available:
+    if available is not None and growth_bytes(s, c.grid.shape, [(axis, extra), *then]) > available:
         extra = max(need, 1)  # the wanted room does not fit in memory: the room the particles need
     check_raise_memory(s, c.grid.shape, extra, available, axis, then)
     grow_grid(s, c, axis, extra)
@@ -683,18 +687,18 @@ def growth_bytes(s: State, shape: tuple[int, int, int], growths: list[tuple[int,
 
 
 def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None,
-                       axis: int = 2, then: tuple[int, int] | None = None) -> None:
-    """Stop before growing the grid by ``extra`` node layers along ``axis``, and then by ``then`` (axis, node
-    layers) where given, if that would not fit in ``available`` bytes, this machine's physical memory
+                       axis: int = 2, then: tuple[tuple[int, int], ...] = ()) -> None:
+    """Stop before growing the grid by ``extra`` node layers along ``axis``, and then by each of ``then``
+    ((axis, node layers), ...), if that would not fit in ``available`` bytes, this machine's physical memory
     (:func:`growth_bytes`; ``check_memory`` counted the particles alone, before the grid could grow); None:
     not known, no check. The whole machine's memory: jobs beside the run are not counted."""
     if available is None:
         return
-    peak = growth_bytes(s, shape, [(axis, extra), *([then] if then else [])])
+    peak = growth_bytes(s, shape, [(axis, extra), *then])
     if peak > available:
         what = ("rose above the grid's top, and raising it" if axis == 2
                 else "passed the grid's far end, and lengthening it")
-        more = f" and then lengthening it by {then[1]}" if then else ""
+        more = "".join(f" and then {'raising' if a == 2 else 'lengthening'} it by {n}" for a, n in then)
         raise InstabilityError(
             f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material {what} "
             f"by {extra} node layers{more} would hold {peak / 2**30:.3g} GiB, more than this machine's "
