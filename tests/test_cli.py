@@ -22,7 +22,20 @@ def test_bad_value_is_one_line_and_exit_2(capsys):
     args[args.index("--load-N") + 1] = "-3"
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "load_N = -3 N" in err
+    assert len(err.splitlines()) == 1 and "--load-N = -3 is not allowed; it must be > 0" in err
+
+
+@pytest.mark.parametrize("flag, value, message", [
+    ("--radius-mm", "0", "--radius-mm = 0 is not allowed; it must be > 0"),
+    ("--thickness-um", "-1", "--thickness-um = -1 is not allowed; it must be >= 0"),
+    ("--substrate-hardness-MPa", "nan", "--substrate-hardness-MPa = nan is not allowed; it must be > 0"),
+])
+def test_analytical_refusal_names_the_option_and_the_value_as_typed(flag, value, message, capsys):
+    args = list(ARGS)
+    args[args.index(flag) + 1] = value
+    assert main(args) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err
 
 
 def test_python_m_and_help():
@@ -116,3 +129,37 @@ def test_mpm_bad_thread_count_names_the_option(tmp_path, capsys):
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and "threads = 0 is outside the allowed range 1.." in err
     assert not (tmp_path / "r.nc").exists()
+
+
+def _refuse_to_simulate(monkeypatch):
+    import plough.mpm.run as run
+
+    def fail(*_a, **_kw):
+        raise AssertionError("the run started although its output cannot be written")
+
+    monkeypatch.setattr(run, "simulate", fail)
+
+
+@pytest.mark.parametrize("case, message", [
+    ("output is a directory", "is a directory; give a file name"),
+    ("output folder is a file", "output folder"),
+    ("snapshots is a file", "snapshots"),
+])
+def test_mpm_unwritable_output_is_refused_before_the_run(case, message, monkeypatch, tmp_path, capsys):
+    from pathlib import Path
+
+    _refuse_to_simulate(monkeypatch)
+    scene = Path(__file__).resolve().parents[1] / "examples" / "stability_small.yaml"
+    a_file = tmp_path / "afile"
+    a_file.write_text("")
+    out, snaps = tmp_path / "r.nc", None
+    if case == "output is a directory":
+        out.mkdir()
+    elif case == "output folder is a file":
+        out = a_file / "r.nc"
+    else:
+        snaps = a_file
+    argv = ["mpm", str(scene), "-o", str(out), "--quiet"] + (["--snapshots", str(snaps)] if snaps else [])
+    assert main(argv) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and message in err and "Traceback" not in err

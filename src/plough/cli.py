@@ -6,6 +6,7 @@ Bad input gives a one-line message naming the parameter and exit code 2, never a
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Callable, Sequence
 from typing import TYPE_CHECKING
@@ -76,17 +77,33 @@ def _interface_options(args: argparse.Namespace) -> None:
                 setattr(args, dest, default)
 
 
+#: the model's parameter names (SI) -> (the option that gives it, its attribute), to name refused values as typed
+_ANALYTICAL_FLAGS = {"radius_m": ("--radius-mm", "radius_mm"), "thickness_m": ("--thickness-um", "thickness_um"),
+                     "coating_hardness_Pa": ("--coating-hardness-MPa", "coating_hardness_MPa"),
+                     "substrate_hardness_Pa": ("--substrate-hardness-MPa", "substrate_hardness_MPa"),
+                     "load_N": ("--load-N", "load_N"), "H0_Pa": ("--H0-MPa", "H0_MPa"), "k1": ("--k1", "k1"),
+                     "f": ("--f", "f"), "Cp": ("--Cp", "Cp"), "np": ("--np", "np_exponent")}
+_REFUSED = re.compile(r"(\w+) = \S+ .*?(is not allowed; it must be [<>]=? 0|is outside the allowed range \[[^]]*\])")
+
+
 def _run_analytical(args: argparse.Namespace) -> int:
     from plough.analytical import RESULT_META, ploughing
 
     _interface_options(args)
-    res = ploughing(
-        load_N=args.load_N, radius_m=args.radius_mm * 1e-3, thickness_m=args.thickness_um * 1e-6,
-        coating_hardness_Pa=args.coating_hardness_MPa * 1e6,
-        substrate_hardness_Pa=args.substrate_hardness_MPa * 1e6, k1=args.k1,
-        interface=args.interface, f=args.f, H0_Pa=args.H0_MPa * 1e6, Cp=args.Cp,
-        np_exponent=args.np_exponent, correction=args.correction,
-    ).squeeze()
+    try:
+        res = ploughing(
+            load_N=args.load_N, radius_m=args.radius_mm * 1e-3, thickness_m=args.thickness_um * 1e-6,
+            coating_hardness_Pa=args.coating_hardness_MPa * 1e6,
+            substrate_hardness_Pa=args.substrate_hardness_MPa * 1e6, k1=args.k1,
+            interface=args.interface, f=args.f, H0_Pa=args.H0_MPa * 1e6, Cp=args.Cp,
+            np_exponent=args.np_exponent, correction=args.correction,
+        ).squeeze()
+    except ValueError as exc:  # the model names its SI parameter: name the option and the value typed
+        refused = _REFUSED.match(str(exc))
+        if refused is None or refused.group(1) not in _ANALYTICAL_FLAGS:
+            raise
+        flag, dest = _ANALYTICAL_FLAGS[refused.group(1)]
+        raise ValueError(f"{flag} = {getattr(args, dest):g} {refused.group(2)}") from None
     scale = {"m": (1e6, "um"), "m2": (1e12, "um^2"), "Pa": (1e-6, "MPa"), "N": (1.0, "N"), "1": (1.0, "")}
     print(f"plough {__version__} - analytical ploughing model (Mishra et al. 2020, eqs. 1-5)")
     print(f"r = {args.radius_mm:g} mm, Fn = {args.load_N:g} N, t = {args.thickness_um:g} um, "
@@ -150,7 +167,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     func: Callable[[argparse.Namespace], int] = args.func
     try:
         return func(args)
-    except (ValueError, FileNotFoundError, RuntimeError) as exc:  # RuntimeError: an unstable MPM run
+    # RuntimeError: an unstable MPM run; OSError: a file that cannot be read or written
+    except (ValueError, OSError, RuntimeError) as exc:
         print(f"plough {args.command}: error: {exc}", file=sys.stderr)
         return 2
 

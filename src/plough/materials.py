@@ -37,6 +37,12 @@ def _check_positive(owner: str, **values: float) -> None:
             raise ValueError(f"{owner}: {name} = {value!r} is not allowed; it must be a finite number > 0")
 
 
+def _check_non_negative(owner: str, **values: float) -> None:
+    for name, value in values.items():
+        if not (isinstance(value, int | float) and math.isfinite(value) and value >= 0):
+            raise ValueError(f"{owner}: {name} = {value!r} is not allowed; it must be a finite number >= 0")
+
+
 def _check_range(owner: str, name: str, value: float, lo: float, hi: float) -> None:
     if not (isinstance(value, int | float) and lo <= value <= hi):
         raise ValueError(f"{owner}: {name} = {value!r} is outside the allowed range [{lo}, {hi}]")
@@ -83,6 +89,7 @@ class BergstromVanLiempt:
             m=self.m,
             dG0_eV=self.dG0_eV,
         )
+        _check_non_negative("BergstromVanLiempt", beta=self.beta, eps0=self.eps0, sigma_v0_Pa=self.sigma_v0_Pa)
 
 
 @dataclass(frozen=True)
@@ -104,8 +111,9 @@ class JohnsonCook:
     def __post_init__(self) -> None:
         _check_positive(
             "JohnsonCook", A_Pa=self.A_Pa, p=self.p, rate0_per_s=self.rate0_per_s, q=self.q,
-            T0_K=self.T0_K,
+            T0_K=self.T0_K, Tm_K=self.Tm_K,
         )
+        _check_non_negative("JohnsonCook", B_Pa=self.B_Pa, C=self.C)
         if not self.Tm_K > self.T0_K:
             raise ValueError(f"JohnsonCook: Tm_K = {self.Tm_K!r} must exceed T0_K = {self.T0_K!r}")
 

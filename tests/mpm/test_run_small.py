@@ -903,3 +903,13 @@ def test_the_cached_flow_stress_at_rest_follows_every_particle_through_a_run():
     expected = np.array([mixed_flow_stress(table[p.mat_a[i]], table[p.mat_b[i]], p.frac_a[i], p.eps_p[i], 0.0,
                                            p.temperature[i]) for i in range(p.n)])
     np.testing.assert_array_equal(p.sigma_y0, expected)
+
+
+@pytest.mark.filterwarnings("ignore::plough.mpm.run.SteadyStateWarning")
+def test_snapshots_closer_than_a_micrometre_keep_their_own_files(tmp_path):
+    """Snapshots 0.67 um apart: each gets its own file (names in whole micrometres overwrote half of them)."""
+    scene = Scene.from_dict(scene_dict(outputs={**TINY["outputs"], "snapshots": 300}))
+    simulate(scene, progress=False, threads=1, snapshots_dir=tmp_path)
+    files = sorted(p.name for p in tmp_path.glob("*.vtp"))
+    assert "tiny_final.vtp" in files
+    assert len(files) >= 301

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import yaml
 
-from plough.materials import DX56, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
+from plough.materials import DX56, ZINC_BULK, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
 from plough.mpm import contact, io, solver
 from plough.mpm.constitutive import I_RHO
 from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
@@ -102,6 +102,12 @@ def test_yaml_exponent_without_sign_is_coerced_to_a_number():
 
 
 # ----------------------------------------------------------------------------- bad input
+def _flow_changed(material, **flow):
+    d = material.to_dict()
+    d["flow"] = {**d["flow"], **flow}
+    return d
+
+
 def _mutate(**changes):
     d = example_dict()
     for path, value in changes.items():
@@ -195,6 +201,27 @@ BAD = {
                                     r"layers\.substrate\.rigid_plastic_hardness_Pa = None is not a number"),
     "rigid-plastic SI hardness text": (_mutate(layers__substrate={"rigid_plastic_hardness_Pa": "hard"}),
                                        r"layers\.substrate\.rigid_plastic_hardness_Pa = 'hard' is not a number"),
+    # flow-law constants: refused by name, not a traceback from the analytical sizing or a NaN mid-run
+    "Bergstrom-van Liempt eps0 negative": (_mutate(layers__substrate=_flow_changed(DX56, eps0=-1.0)),
+                                           r"BergstromVanLiempt: eps0 = -1\.0 is not allowed; .* >= 0"),
+    "Bergstrom-van Liempt sigma_v0 nan": (_mutate(layers__substrate=_flow_changed(DX56, sigma_v0_Pa=float("nan"))),
+                                          r"BergstromVanLiempt: sigma_v0_Pa = nan"),
+    "Bergstrom-van Liempt beta nan": (_mutate(layers__substrate=_flow_changed(DX56, beta=float("nan"))),
+                                      r"BergstromVanLiempt: beta = nan"),
+    "Johnson-Cook B nan": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, B_Pa=float("nan"))),
+                           r"JohnsonCook: B_Pa = nan"),
+    "Johnson-Cook C negative": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, C=-0.1)), r"JohnsonCook: C = -0\.1"),
+    "Johnson-Cook Tm inf": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, Tm_K=float("inf"))),
+                            r"JohnsonCook: Tm_K = inf"),
+    "initial temperature above the melting point": (
+        _mutate(layers__substrate="zinc_bulk", outputs__initial_temperature_K=800),
+        r"outputs\.initial_temperature_K = 800 K is not below the melting temperature Tm_K = 692\.68 K of the "
+        r"substrate material 'zinc_bulk'"),
+    "one length in two units": (_mutate(sphere__radius_mm=0.5), r"both sphere\.radius_um and sphere\.radius_mm given"),
+    "one hardness in two units": (_mutate(layers__substrate={"rigid_plastic_hardness_MPa": 900,
+                                                             "rigid_plastic_hardness_GPa": 2}),
+                                  r"both layers\.substrate\.rigid_plastic_hardness_MPa and "
+                                  r"layers\.substrate\.rigid_plastic_hardness_GPa given"),
     "material flow text": (_mutate(layers__substrate={**DX56.to_dict(), "flow": {"model": "constant",
                                                                                  "sigma_y_Pa": "hard"}}),
                            r"layers\.substrate\.flow\.sigma_y_Pa = 'hard' is not a number"),
@@ -275,6 +302,15 @@ def test_scene_file_errors_are_one_line_value_errors(tmp_path):
         Scene.from_yaml(broken)
     with pytest.raises(ValueError, match="is a directory"):
         Scene.from_yaml(tmp_path)
+    twice = tmp_path / "twice.yaml"  # PyYAML would keep the second value silently
+    twice.write_text(broken.read_text().replace("{radius_um: 200\n", "{radius_um: 200}\nload_N: 100\n"))
+    with pytest.raises(ValueError, match=r"twice\.yaml: not valid YAML at line 4, column 1: key 'load_N' is given "
+                                         r"twice in one mapping"):
+        Scene.from_yaml(twice)
+    binary = tmp_path / "binary.yaml"
+    binary.write_bytes(b"\xff\xfe name: x\n")
+    with pytest.raises(ValueError, match=r"binary\.yaml' is not a text \(UTF-8\) YAML file"):
+        Scene.from_yaml(binary)
 
 
 def test_a_scene_too_large_for_the_memory_is_refused_before_allocating():

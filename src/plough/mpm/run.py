@@ -7,6 +7,7 @@
 from __future__ import annotations
 
 import numbers
+import os
 import time
 import warnings
 from collections.abc import Callable
@@ -154,7 +155,8 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                     f"the sphere did not reach the load in {state.step} steps: load_N = {scene.load_N:g} N may be "
                     "too high for the domain, or the contact is lost")
             if snapshots_dir is not None and state.sphere.slid_m >= next_snap and state.sphere.phase == "slide":
-                name = f"{scene.name}_{int(round(next_snap * 1e6)):05d}um.vtp"
+                # nanometres: whole micrometres repeat where snapshots lie less than 1 um apart
+                name = f"{scene.name}_{int(round(next_snap * 1e9)):010d}nm.vtp"
                 io.write_snapshot(state.particles, Path(snapshots_dir) / name, state.sphere.centre,
                                   const.sphere_radius, coating_row)
                 next_snap += snap_every
@@ -241,10 +243,29 @@ def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir:
     if threads is not None:
         check_threads(threads)
     scene = apply_preset(Scene.from_yaml(Path(scene_path)), preset)
+    check_output_paths(output, snapshots_dir)
     if on_scene is not None:
         on_scene(scene)
     ds = simulate(scene, progress=progress, snapshots_dir=snapshots_dir, threads=threads)
     return io.write_result(ds, output)
+
+
+def check_output_paths(output: str | Path, snapshots_dir: str | Path | None = None) -> None:
+    """Refuse, before a run, an output file or snapshot directory that could not be written afterwards.
+
+    Creates the output's folder and the snapshot directory (as the writers would).
+    """
+    out = Path(output)
+    if out.is_dir():
+        raise ValueError(f"output {str(out)!r} is a directory; give a file name (for example run.nc)")
+    folders = [("output folder", out.parent)] + ([("snapshots", Path(snapshots_dir))] if snapshots_dir else [])
+    for what, folder in folders:
+        try:
+            folder.mkdir(parents=True, exist_ok=True)
+        except OSError as exc:
+            raise ValueError(f"{what} {str(folder)!r} cannot be created: {exc.strerror}") from None
+        if not os.access(folder, os.W_OK | os.X_OK):
+            raise ValueError(f"{what} {str(folder)!r} is not writable")
 
 
 def warm_up(threads: int | None = None) -> float:

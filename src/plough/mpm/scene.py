@@ -28,6 +28,7 @@ from plough.materials import (
     ConstantFlow,
     ConstantShear,
     Interface,
+    JohnsonCook,
     Material,
     ProportionalShear,
     get_material,
@@ -37,6 +38,29 @@ from plough.materials import (
     representative_hardness,
     rigid_plastic,
 )
+
+
+class _UniqueKeyLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing a key given twice in one mapping (it keeps the last one silently)."""
+
+
+def _construct_unique_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict:
+    loader.flatten_mapping(node)
+    seen: set = set()
+    for key_node, _ in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        try:
+            twice = key in seen
+        except TypeError:  # an unhashable key: construct_mapping names it
+            break
+        if twice:
+            raise yaml.constructor.ConstructorError(None, None, f"key {key!r} is given twice in one mapping",
+                                                    key_node.start_mark)
+        seen.add(key)
+    return loader.construct_mapping(node, deep=deep)
+
+
+_UniqueKeyLoader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_unique_mapping)
 
 _UNIT_SUFFIXES = {"_um": ("_m", 1e-6), "_mm": ("_m", 1e-3), "_MPa": ("_Pa", 1e6), "_GPa": ("_Pa", 1e9)}
 
@@ -68,13 +92,18 @@ def _number(value: Any, where: str) -> float:
 
 def _to_si(d: dict[str, Any], where: str = "") -> dict[str, Any]:
     out: dict[str, Any] = {}
+    given_as: dict[str, str] = {}  # SI key -> the key it was given as
     prefix = f"{where}." if where else ""
     for key, value in d.items():
         for suffix, (si_suffix, factor) in _UNIT_SUFFIXES.items():
             if isinstance(key, str) and key.endswith(suffix):
                 new = key[: -len(suffix)] + si_suffix
                 if new in d:
-                    raise ValueError(f"both {key!r} and {new!r} given; give one")
+                    raise ValueError(f"both {prefix}{key} and {prefix}{new} given; give one")
+                if new in given_as:
+                    raise ValueError(f"both {prefix}{given_as[new]} and {prefix}{key} given (the same "
+                                     "quantity in two units); give one")
+                given_as[new] = key
                 out[new] = None if value is None else _number(value, f"{prefix}{key}") * factor
                 break
         else:
@@ -475,7 +504,19 @@ class Scene:
         _finite_positive("scene", "load_N", self.load_N, "N")
         if not isinstance(self.interface, ProportionalShear | ConstantShear | BoundaryLayerShear):
             raise ValueError(f"interface = {self.interface!r} is not an interface model")
+        self._check_below_melting()
         self._check_fits()
+
+    def _check_below_melting(self) -> None:
+        """A Johnson-Cook layer has no strength at or above its melting temperature Tm_K."""
+        T = self.outputs.initial_temperature_K
+        layers = [("substrate", self.layers.substrate)] + ([("coating", self.layers.coating)]
+                                                            if self.layers.coated else [])
+        for where, m in layers:
+            if isinstance(m.flow, JohnsonCook) and T >= m.flow.Tm_K:
+                raise ValueError(f"outputs.initial_temperature_K = {T:g} K is not below the melting temperature "
+                                 f"Tm_K = {m.flow.Tm_K:g} K of the {where} material {m.name!r} (allowed: "
+                                 f"0 < T < {m.flow.Tm_K:g} K)")
 
     # -- feasibility: refuse what cannot work before running
     def expected_contact(self) -> tuple[float, float]:
@@ -688,13 +729,18 @@ class Scene:
                 raise FileNotFoundError(f"scene file {str(p)!r} does not exist")
             if p.is_dir():
                 raise ValueError(f"scene file {str(p)!r} is a directory, not a YAML file")
-            text = p.read_text()
+            try:
+                text = p.read_text()
+            except UnicodeDecodeError as exc:
+                raise ValueError(f"scene file {str(p)!r} is not a text (UTF-8) YAML file: {exc.reason} at byte "
+                                 f"{exc.start}") from None
             source = str(p)
         else:
             text = str(path_or_text)
             source = "scene text"
         try:
-            data = yaml.safe_load(text)  # YAML 1.1: 5e-1 is text; the parts convert numbers by their field types
+            # YAML 1.1: 5e-1 is text; the parts convert numbers by their field types
+            data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader)
         except yaml.YAMLError as exc:
             where = getattr(exc, "problem_mark", None)
             at = f" at line {where.line + 1}, column {where.column + 1}" if where is not None else ""
@@ -738,6 +784,10 @@ def expected_contact(layers: Layers, load_N: float, sphere_radius_m: float) -> t
 
     Hs = representative_hardness(layers.substrate)
     Hc = representative_hardness(layers.coating) if layers.coated else Hs
+    for where, H, m in (("substrate", Hs, layers.substrate), ("coating", Hc, layers.coating)):
+        if not (math.isfinite(H) and H > 0):
+            raise ValueError(f"layers.{where}: material {m.name!r} gives a hardness 3 sigma_y(0.08) = {H!r} Pa; "
+                             "its flow-stress parameters must give a finite flow stress > 0")
     try:
         res = ploughing(load_N, sphere_radius_m, layers.coating_thickness_m, Hc, Hs, k1=125.0)
     except ValueError:
