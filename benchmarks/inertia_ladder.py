@@ -21,6 +21,7 @@ from pathlib import Path
 import numba
 from common import coated_reference, run_scene
 
+from plough.io import git_commit
 from plough.materials import ProportionalShear
 from plough.mpm.solver import SimulationError
 
@@ -39,6 +40,8 @@ def main() -> None:
     out = args.out or ROOT / "benchmarks" / "results" / f"inertia_ladder_h{args.h_um:g}.json"
     numba.set_num_threads(args.threads)
     data = json.loads(out.read_text()) if out.exists() else {"h_um": args.h_um, "runs": {}}
+    if data["h_um"] != args.h_um:
+        raise SystemExit(f"{out} holds runs at h = {data['h_um']:g} um, not --h-um {args.h_um:g}")
     runs = data["runs"]
     base = coated_reference(args.h_um)
     for f in args.f:
@@ -53,7 +56,7 @@ def main() -> None:
             try:
                 row.update(run_scene(scene, threads=args.threads))
             except SimulationError as exc:  # a stopped run is a result too
-                row["stopped"] = str(exc)
+                row.update(stopped=str(exc), git_commit=git_commit())
             runs[name] = row
             print(name, json.dumps(row), flush=True)
             out.write_text(json.dumps(data, indent=2) + "\n")

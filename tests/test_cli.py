@@ -22,13 +22,14 @@ def test_bad_value_is_one_line_and_exit_2(capsys):
     args[args.index("--load-N") + 1] = "-3"
     assert main(args) == 2
     err = capsys.readouterr().err.strip()
-    assert len(err.splitlines()) == 1 and "--load-N = -3 is not allowed; it must be > 0" in err
+    assert len(err.splitlines()) == 1 and "--load-N = -3 is not allowed; it must be a finite number > 0" in err
 
 
 @pytest.mark.parametrize("flag, value, message", [
-    ("--radius-mm", "0", "--radius-mm = 0 is not allowed; it must be > 0"),
-    ("--thickness-um", "-1", "--thickness-um = -1 is not allowed; it must be >= 0"),
-    ("--substrate-hardness-MPa", "nan", "--substrate-hardness-MPa = nan is not allowed; it must be > 0"),
+    ("--radius-mm", "0", "--radius-mm = 0 is not allowed; it must be a finite number > 0"),
+    ("--thickness-um", "-1", "--thickness-um = -1 is not allowed; it must be a finite number >= 0"),
+    ("--substrate-hardness-MPa", "nan", "--substrate-hardness-MPa = nan is not allowed; it must be a finite"),
+    ("--coating-hardness-MPa", "1e303", "--coating-hardness-MPa = 1e+303 is not allowed; it must be a finite number"),
 ])
 def test_analytical_refusal_names_the_option_and_the_value_as_typed(flag, value, message, capsys):
     args = list(ARGS)

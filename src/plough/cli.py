@@ -103,7 +103,8 @@ def _run_analytical(args: argparse.Namespace) -> int:
         if refused is None or refused.group(1) not in _ANALYTICAL_FLAGS:
             raise
         flag, dest = _ANALYTICAL_FLAGS[refused.group(1)]
-        raise ValueError(f"{flag} = {getattr(args, dest):g} {refused.group(2)}") from None
+        rule = refused.group(2).replace("it must be", "it must be a finite number")  # 1e303 MPa is inf in Pa
+        raise ValueError(f"{flag} = {getattr(args, dest):g} {rule}") from None
     scale = {"m": (1e6, "um"), "m2": (1e12, "um^2"), "Pa": (1e-6, "MPa"), "N": (1.0, "N"), "1": (1.0, "")}
     print(f"plough {__version__} - analytical ploughing model (Mishra et al. 2020, eqs. 1-5)")
     print(f"r = {args.radius_mm:g} mm, Fn = {args.load_N:g} N, t = {args.thickness_um:g} um, "

@@ -22,7 +22,8 @@ from plough.mpm import contact, io, solver
 from plough.mpm.constitutive import I_RHO
 from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
 
-EXAMPLES = sorted((Path(__file__).resolve().parents[2] / "examples").glob("*.yaml"))
+EXAMPLES_DIR = Path(__file__).resolve().parents[2] / "examples"
+EXAMPLES = sorted(EXAMPLES_DIR.glob("*.yaml"))
 
 
 def example_dict(name="uncoated_rigid_plastic"):
@@ -308,9 +309,20 @@ def test_scene_file_errors_are_one_line_value_errors(tmp_path):
                                          r"twice in one mapping"):
         Scene.from_yaml(twice)
     binary = tmp_path / "binary.yaml"
-    binary.write_bytes(b"\xff\xfe name: x\n")
-    with pytest.raises(ValueError, match=r"binary\.yaml' is not a text \(UTF-8\) YAML file"):
+    binary.write_bytes(b"name: \xff x\n")  # not UTF-8 (nor UTF-16: no byte-order mark)
+    with pytest.raises(ValueError, match=r"binary\.yaml: not valid YAML: unacceptable character #x00ff"):
         Scene.from_yaml(binary)
+    merged = tmp_path / "merged.yaml"  # overriding a key a merge key (<<) brings in is not a duplicate
+    example = (EXAMPLES_DIR / "coated_rigid_plastic.yaml").read_text()
+    line = "discretisation: {particle_size_um: 10, particles_per_cell: 2, cfl: 0.3, mass_scaling: 1.0e+6}"
+    assert line in example
+    merged.write_text(example.replace(line, "discretisation: {<<: {particle_size_um: 20, cfl: 0.2}, cfl: 0.25}"))
+    assert (Scene.from_yaml(merged).discretisation.cfl, Scene.from_yaml(merged).discretisation.particle_size_m
+            ) == (0.25, pytest.approx(20e-6))
+    utf16 = tmp_path / "utf16.yaml"  # a byte-order mark: valid YAML in UTF-16, read as such whatever the locale
+    utf16.write_bytes("name: µ\nload_N: 1\nload_N: 2\n".encode("utf-16"))
+    with pytest.raises(ValueError, match=r"key 'load_N' is given twice"):
+        Scene.from_yaml(utf16)
 
 
 def test_a_scene_too_large_for_the_memory_is_refused_before_allocating():

@@ -45,9 +45,11 @@ class _UniqueKeyLoader(yaml.SafeLoader):
 
 
 def _construct_unique_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, deep: bool = False) -> dict:
-    loader.flatten_mapping(node)
+    # the mapping's own keys only, before merge keys (<<) splice theirs in: overriding a merged key is allowed
     seen: set = set()
     for key_node, _ in node.value:
+        if key_node.tag == "tag:yaml.org,2002:merge":
+            continue
         key = loader.construct_object(key_node, deep=True)
         try:
             twice = key in seen
@@ -57,6 +59,7 @@ def _construct_unique_mapping(loader: _UniqueKeyLoader, node: yaml.MappingNode, 
             raise yaml.constructor.ConstructorError(None, None, f"key {key!r} is given twice in one mapping",
                                                     key_node.start_mark)
         seen.add(key)
+    loader.flatten_mapping(node)
     return loader.construct_mapping(node, deep=deep)
 
 
@@ -729,11 +732,8 @@ class Scene:
                 raise FileNotFoundError(f"scene file {str(p)!r} does not exist")
             if p.is_dir():
                 raise ValueError(f"scene file {str(p)!r} is a directory, not a YAML file")
-            try:
-                text = p.read_text()
-            except UnicodeDecodeError as exc:
-                raise ValueError(f"scene file {str(p)!r} is not a text (UTF-8) YAML file: {exc.reason} at byte "
-                                 f"{exc.start}") from None
+            # bytes: the YAML reader detects UTF-8 / UTF-16 itself, whatever the locale
+            text: str | bytes = p.read_bytes()
             source = str(p)
         else:
             text = str(path_or_text)
