@@ -101,82 +101,20 @@ def _fma_chains(a, reps, s, t):
                 row[i + 7 * h] = y7
 
 
-@njit(cache=True, parallel=True, fastmath=True)
-def _fma_and_add_chains(a, b, reps, s, t):
-    """As :func:`_fma_chains` on a, with four chains of dependent adds on b (threads x n/2) beside them.
-
-    Reads and writes a and b. Zen 3 and later cores have add pipes beside their FMA pipes: the adds
-    of a scatter could run there, so the floor must count them (race-free as ``_fma_chains``).
-    """
-    for c in prange(a.shape[0]):
-        row = a[c]
-        acc = b[c]
-        h = row.size // 8
-        for _ in range(reps):
-            for i in range(h):
-                y0 = row[i]
-                y1 = row[i + h]
-                y2 = row[i + 2 * h]
-                y3 = row[i + 3 * h]
-                y4 = row[i + 4 * h]
-                y5 = row[i + 5 * h]
-                y6 = row[i + 6 * h]
-                y7 = row[i + 7 * h]
-                z0 = acc[i]
-                z1 = acc[i + h]
-                z2 = acc[i + 2 * h]
-                z3 = acc[i + 3 * h]
-                for _k in range(CHAIN_LENGTH):
-                    y0 = y0 * s + t
-                    y1 = y1 * s + t
-                    y2 = y2 * s + t
-                    y3 = y3 * s + t
-                    y4 = y4 * s + t
-                    y5 = y5 * s + t
-                    y6 = y6 * s + t
-                    y7 = y7 * s + t
-                    z0 = z0 + t
-                    z1 = z1 + t
-                    z2 = z2 + t
-                    z3 = z3 + t
-                row[i] = y0
-                row[i + h] = y1
-                row[i + 2 * h] = y2
-                row[i + 3 * h] = y3
-                row[i + 4 * h] = y4
-                row[i + 5 * h] = y5
-                row[i + 6 * h] = y6
-                row[i + 7 * h] = y7
-                acc[i] = z0
-                acc[i + h] = z1
-                acc[i + 2 * h] = z2
-                acc[i + 3 * h] = z3
-
-
-def peak_flops(threads: int, repeats: int, with_adds: bool = False, n: int = 1024,
-               flops_per_call: float = 4e9) -> list[float]:
-    """FLOP/s of the FMA probe (``with_adds``: FMA and add chains) on ``threads`` threads, one value per
-    repetition (after a warm-up call)."""
+def peak_flops(threads: int, repeats: int, n: int = 1024, flops_per_call: float = 4e9) -> list[float]:
+    """FLOP/s of the FMA probe on ``threads`` threads, one value per repetition (after a warm-up call)."""
     numba.set_num_threads(threads)
     a = np.ones((threads, n))
-    b = np.ones((threads, n // 2))
-    s, t = 0.999999, 1e-6  # fixed point 1: the values neither grow nor go subnormal (b grows by t per add)
-    flops_per_rep = threads * n * CHAIN_LENGTH * (2 + (0.5 if with_adds else 0.0))
-
-    def call(reps: int) -> None:
-        if with_adds:
-            _fma_and_add_chains(a, b, reps, s, t)
-        else:
-            _fma_chains(a, reps, s, t)
-
-    call(1)
+    s, t = 0.999999, 1e-6  # fixed point 1: the values neither grow nor go subnormal
+    flops_per_rep = threads * n * CHAIN_LENGTH * 2
+    _fma_chains(a, 1, s, t)
     reps = max(1, int(flops_per_call / flops_per_rep))
     rates = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        call(reps)
+        _fma_chains(a, reps, s, t)
         rates.append(reps * flops_per_rep / (time.perf_counter() - t0))
-    if not (np.all(np.isfinite(a)) and np.all(np.isfinite(b))):
+    if not np.all(np.isfinite(a)):
         raise RuntimeError("the FMA probe produced non-finite values")
     return rates
 
@@ -191,12 +129,12 @@ def main() -> None:
     args = parser.parse_args()
     flops = min_flops_per_particle_step()
     rates = {f"fma {n} thread(s)": peak_flops(n, args.repeats) for n in (1, args.threads)}
-    rates.update({f"fma+add {n} thread(s)": peak_flops(n, args.repeats, with_adds=True) for n in (1, args.threads)})
     for name, r in rates.items():
         print(f"{name:22s} median {statistics.median(r) / 1e9:5.1f} GFLOP/s, fastest {max(r) / 1e9:5.1f} "
               f"({args.repeats} repeats)")
     # the clock the fastest FMA repeat implies at two 4-wide FMA pipes a core (16 flops a cycle), and the
-    # core's whole width at that clock: two FMA and two add pipes, 24 flops a cycle
+    # core's whole width at that clock: Zen 3 has two add pipes beside them (a scatter's adds could run
+    # there), 24 flops a cycle
     clock_hz = max(rates[f"fma {args.threads} thread(s)"]) / (FMA_FLOPS_PER_CYCLE * args.threads)
     peak = max([WIDE_FLOPS_PER_CYCLE * clock_hz * args.threads] + [max(r) for r in rates.values()])
     print(f"clock implied {clock_hz / 1e9:.2f} GHz; upper bound {peak / 1e9:.1f} GFLOP/s on {args.threads} threads "
