@@ -113,7 +113,9 @@ class JohnsonCook:
             "JohnsonCook", A_Pa=self.A_Pa, p=self.p, rate0_per_s=self.rate0_per_s, q=self.q,
             T0_K=self.T0_K, Tm_K=self.Tm_K,
         )
-        _check_non_negative("JohnsonCook", B_Pa=self.B_Pa, C=self.C)
+        _check_non_negative("JohnsonCook", B_Pa=self.B_Pa)
+        if not (isinstance(self.C, int | float) and math.isfinite(self.C)):  # C < 0 (softening with rate) is allowed
+            raise ValueError(f"JohnsonCook: C = {self.C!r} is not allowed; it must be a finite number")
         if not self.Tm_K > self.T0_K:
             raise ValueError(f"JohnsonCook: Tm_K = {self.Tm_K!r} must exceed T0_K = {self.T0_K!r}")
 

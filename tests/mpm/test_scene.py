@@ -211,7 +211,8 @@ BAD = {
                                       r"BergstromVanLiempt: beta = nan"),
     "Johnson-Cook B nan": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, B_Pa=float("nan"))),
                            r"JohnsonCook: B_Pa = nan"),
-    "Johnson-Cook C negative": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, C=-0.1)), r"JohnsonCook: C = -0\.1"),
+    "Johnson-Cook C inf": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, C=float("inf"))),
+                           r"JohnsonCook: C = inf is not allowed; it must be a finite number"),
     "Johnson-Cook Tm inf": (_mutate(layers__substrate=_flow_changed(ZINC_BULK, Tm_K=float("inf"))),
                             r"JohnsonCook: Tm_K = inf"),
     "initial temperature above the melting point": (
