@@ -513,9 +513,8 @@ class Scene:
     def _check_below_melting(self) -> None:
         """A Johnson-Cook layer has no strength at or above its melting temperature Tm_K."""
         T = self.outputs.initial_temperature_K
-        layers = [("substrate", self.layers.substrate)] + ([("coating", self.layers.coating)]
-                                                            if self.layers.coated else [])
-        for where, m in layers:
+        for m in self.layers.materials:
+            where = "substrate" if m is self.layers.substrate else "coating"
             if isinstance(m.flow, JohnsonCook) and T >= m.flow.Tm_K:
                 raise ValueError(f"outputs.initial_temperature_K = {T:g} K is not below the melting temperature "
                                  f"Tm_K = {m.flow.Tm_K:g} K of the {where} material {m.name!r} (allowed: "
@@ -584,8 +583,7 @@ class Scene:
     def inertia_number(self) -> float:
         """ms rho v^2 / H of the softest layer: the dynamic pressure of the slide over the hardness."""
         ms, v = self.discretisation.mass_scaling, self.sliding.speed_m_s
-        layers = [self.layers.substrate] + ([self.layers.coating] if self.layers.coated else [])
-        return max(ms * m.density_kg_m3 * v * v / representative_hardness(m) for m in layers)
+        return max(ms * m.density_kg_m3 * v * v / representative_hardness(m) for m in self.layers.materials)
 
     def _contact_surfaces(self) -> list[tuple[float, bool]]:
         """(kappa at the onset of yield, perfectly plastic?) of each surface the sphere can touch.
