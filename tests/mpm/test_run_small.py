@@ -24,7 +24,7 @@ from plough import cli
 from plough.mpm import contact, io, solver, transfers
 from plough.mpm import run as run_module
 from plough.mpm import scene as scene_module
-from plough.mpm.grid import boundary_flags
+from plough.mpm.grid import FIXED, FREE, boundary_flags
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
@@ -399,7 +399,7 @@ def test_a_raise_and_a_lengthening_on_one_step_share_the_memory(tiny_scene, monk
     shape = const.grid.shape
     _flag_past_the_end(state, const)  # needs 2 x layers
     state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * const.grid.dx  # needs 2 z layers; doubling wants more
-    assert solver._layers_past_end(state, const) == 2
+    assert solver._layers_past(state, const, 0, const.grid_end_limit_m) == 2
     wanted = math.ceil(const.grid_hi[2] / const.grid.dx - 1e-9)
     assert wanted > 2
     both_needed = solver.growth_bytes(state, shape, [(2, 2), (0, 2)])
@@ -494,6 +494,113 @@ def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_lon
     _assert_same_run(late, start, scene)
 
 
+def _flag_past_the_side(state, const, index=7, over_m=None):
+    """Particle ``index`` moved ``over_m`` (default a fifth of a cell) out through the grid's side (high y)."""
+    _flag_outside(state, const, index, 1, 0.2 * const.grid.dx if over_m is None else over_m)
+
+
+def test_a_particle_past_a_fixed_grids_side_is_named_material_thrown_sideways(tiny_scene):
+    """With a hand-set headroom the grid does not widen: leaving through the side face names it and the
+    block's radius (the f = 0.5 coated run at h = 2.5 um threw a coating particle out there)."""
+    scene = tiny_scene.with_(domain=replace(tiny_scene.domain, headroom_m=tiny_scene.grid_headroom_m))
+    state, const = solver.init(scene, n_chunks=1)
+    assert const.grid_side_limit_m == 0.0
+    _flag_past_the_side(state, const)
+    side = tiny_scene.domain.radius_m * 1e6
+    with pytest.raises(solver.InstabilityError, match=rf"out through the grid's side .*the block's side is at "
+                                                      rf"{side:.1f} um\).*domain\.radius_m") as err:
+        solver.check_stability(state, const)
+    assert "widens" not in str(err.value) and not state.grid_widenings
+
+
+def test_a_particle_past_the_side_widens_the_automatic_grid_up_to_its_limit(tiny_scene):
+    """Room for the particle plus a quarter sphere radius along y, flags the wider grid's own (fixed below the
+    surface, free above), the run goes on; a particle past the limit (two sphere radii past the block's side)
+    stops it, naming the limit; a particle through the bottom on the same step is not hidden by the widening."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    r, dx = tiny_scene.sphere.radius_m, const.grid.dx
+    (nx, ny, nz), side0 = const.grid.shape, float(const.grid_hi[1])
+    assert const.grid_side_limit_m == pytest.approx(tiny_scene.domain.radius_m + 2.0 * r, rel=1e-12)
+    assert side0 > tiny_scene.domain.radius_m
+    old_flags = state.work.flags.copy()
+    _flag_past_the_side(state, const)
+    far = float(state.particles.x[7, 1])
+    solver.check_stability(state, const)  # no error
+    assert const.grid.shape[0] == nx and const.grid.shape[2] == nz and const.grid.shape[1] > ny
+    assert far + dx + 0.25 * r <= const.grid_hi[1] < far + 2.0 * dx + 0.25 * r
+    assert list(const.shape) == list(const.grid.shape)
+    assert state.zone.check_hi_m[1] == const.grid_hi[1] and state.zone.n_hi == const.grid.n_nodes
+    assert state.grid_widenings == [(state.step, state.sphere.slid_m, float(const.grid_hi[1]))]
+    new_ny = const.grid.shape[1]
+    flags = state.work.flags.reshape(nx, new_ny, nz)
+    assert np.array_equal(flags[:, :ny, :], old_flags.reshape(nx, ny, nz))
+    assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
+    z = const.grid.node_positions()[:, 2].reshape(nx, new_ny, nz)
+    assert np.all(flags[:, ny:, :][z[:, ny:, :] < 0] == FIXED) and np.all(flags[:, ny:, :][z[:, ny:, :] >= 0] == FREE)
+    assert state.work.grid_buf.shape[1] == state.work.grid_m.size == state.work.last_push.size == const.grid.n_nodes
+    _flag_past_the_side(state, const, over_m=2.0 * r)
+    limit = rf"widens past the block's side by 2 sphere radii at most, to y = {const.grid_side_limit_m * 1e6:.1f}"
+    with pytest.raises(solver.InstabilityError, match=r"out through the grid's side.*" + limit):
+        solver.check_stability(state, const)
+    assert len(state.grid_widenings) == 1
+    state2, const2 = solver.init(tiny_scene, n_chunks=1)
+    _flag_past_the_side(state2, const2)
+    state2.particles.x[9, 2] = const2.grid_lo[2] - dx
+    with pytest.raises(solver.InstabilityError, match="particle 9 "):
+        solver.check_stability(state2, const2)
+    assert not state2.grid_widenings and const2.grid.shape == (nx, ny, nz)
+
+
+def test_three_growths_on_one_step_all_grow_and_share_the_memory(tiny_scene, monkeypatch):
+    """A particle above the top, one past the far end and one past the side on one step: all three growths
+    happen, and the memory check counts them together (a byte less than the three needed stops the run before
+    any grows, naming all three)."""
+    state, const = solver.init(tiny_scene, n_chunks=2)
+    shape, dx = const.grid.shape, const.grid.dx
+    _flag_past_the_side(state, const)  # needs 2 y layers
+    state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * dx  # 2 z layers
+    state.particles.x[9, 0] = const.grid_hi[0] + 0.2 * dx  # 2 x layers
+    needed = solver.growth_bytes(state, shape, [(2, 2), (0, 2), (1, 2)])
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: needed - 1)
+    with pytest.raises(solver.InstabilityError, match=r"raising it by 2 node layers and then lengthening it by 2 "
+                                                      r"and then widening it by 2 would hold"):
+        solver.check_stability(state, const)
+    assert const.grid.shape == shape and not (state.grid_raises or state.grid_extensions or state.grid_widenings)
+    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: needed)
+    solver.check_stability(state, const)
+    assert const.grid.shape == (shape[0] + 2, shape[1] + 2, shape[2] + 2)
+    assert len(state.grid_raises) == len(state.grid_extensions) == len(state.grid_widenings) == 1
+    assert solver._outside_index(state) == -1
+    assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
+
+
+@pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])
+def test_a_run_whose_grid_was_widened_goes_on_as_if_it_had_started_on_the_wider_grid(tiny_scene, zone):
+    """Widened mid-slide (contact memory and grid buffers in use) against widened at step 0: same particles,
+    same forces; the zone's node range keeps its slabs, each slab wider."""
+    scene = tiny_scene.with_(discretisation=replace(tiny_scene.discretisation, active_zone_contact_radii=zone))
+    late, c_late = solver.init(scene, n_chunks=1)
+    while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6):
+        solver.step(late, c_late)
+    old_slab, slabs = c_late.grid.shape[1] * c_late.grid.shape[2], (late.zone.n_lo, late.zone.n_hi)
+    solver.grow_grid(late, c_late, 1, 5)
+    new_slab = c_late.grid.shape[1] * c_late.grid.shape[2]
+    assert (late.zone.n_lo, late.zone.n_hi) == (slabs[0] // old_slab * new_slab, slabs[1] // old_slab * new_slab)
+    start, c_start = solver.init(scene, n_chunks=1)
+    solver.grow_grid(start, c_start, 1, 5)
+    assert c_start.grid.shape == c_late.grid.shape
+    assert np.array_equal(start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
+    for _ in range(late.step + 150 - start.step):
+        solver.step(start, c_start)
+    for _ in range(150):
+        solver.step(late, c_late)
+    assert start.step == late.step
+    assert (late.zone.n_lo, late.zone.n_hi) == (start.zone.n_lo, start.zone.n_hi)
+    assert (late.zone.p_hi - late.zone.p_lo < late.particles.n) == (zone is not None)
+    assert late.zone.check_hi_m[1] == start.zone.check_hi_m[1] == c_late.grid_hi[1]
+    _assert_same_run(late, start, scene)
+
+
 def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     """The room above the surface doubles, every node keeps its flags, and the run goes on."""
     state, const = solver.init(tiny_scene, n_chunks=1)
@@ -512,10 +619,10 @@ def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     for name in ("grid_m", "grid_div", "last_push"):
         assert getattr(state.work, name).shape[0] == nx * ny * nz, name
     assert state.work.grid_v.shape == (nx * ny * nz, 6) and state.work.grid_buf.shape[1] == nx * ny * nz
-    # another particle left through a side on the same step: the raise does not hide it
+    # another particle left through the bottom on the same step: the raise does not hide it
     state2, const2 = solver.init(tiny_scene, n_chunks=1)
     _flag_above_the_top(state2, const2)
-    state2.particles.x[9, 1] = const2.grid_hi[1] + const2.grid.dx
+    state2.particles.x[9, 2] = const2.grid_lo[2] - const2.grid.dx
     with pytest.raises(solver.InstabilityError, match="particle 9 ") as err:
         solver.check_stability(state2, const2)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value)
@@ -602,7 +709,7 @@ def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatc
     assert tiny_run.attrs["cost_grid_nodes"] == tiny_run.attrs["cost_grid_nodes_end"] == const.grid.n_nodes
     real_step = solver.step
 
-    def step_raising_once(s, c):  # as check_stability would on a particle past the top, then past the end
+    def step_raising_once(s, c):  # as check_stability would on a particle past the top, the end, then the side
         real_step(s, c)
         if s.step == 40:
             assert solver.raise_grid_top(s, c)
@@ -610,6 +717,10 @@ def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatc
             s.particles.x[3, 0] = c.grid_hi[0] + 0.1 * c.grid.dx
             assert solver.lengthen_grid(s, c)
             s.particles.x[3, 0] -= 0.1 * c.grid.dx
+        if s.step == 60:
+            s.particles.x[3, 1] = c.grid_hi[1] + 0.1 * c.grid.dx
+            assert solver.widen_grid(s, c)
+            s.particles.x[3, 1] -= 0.1 * c.grid.dx
 
     monkeypatch.setattr(solver, "step", step_raising_once)
     short = tiny_scene.with_(sliding=replace(tiny_scene.sliding, distance_m=100e-6))
@@ -626,6 +737,11 @@ def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatc
     assert tiny_run.attrs["cost_grid_end_m"] == pytest.approx(const.grid_hi[0], rel=1e-12)
     assert ds.attrs["cost_grid_end_extensions"] == 1
     assert ds.attrs["cost_grid_end_m"] > const.grid_hi[0] + 0.25 * tiny_scene.sphere.radius_m
+    assert "material passed the grid's side at step 60" in told and "the grid widened to y = " in told
+    assert tiny_run.attrs["cost_grid_side_widenings"] == 0
+    assert tiny_run.attrs["cost_grid_side_m"] == pytest.approx(const.grid_hi[1], rel=1e-12)
+    assert ds.attrs["cost_grid_side_widenings"] == 1
+    assert ds.attrs["cost_grid_side_m"] > const.grid_hi[1] + 0.25 * tiny_scene.sphere.radius_m
 
 
 def test_grid_top_follows_the_headroom(tiny_scene):

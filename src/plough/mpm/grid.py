@@ -56,11 +56,12 @@ def make_grid(length_m: float, radius_m: float, symmetric: bool, dx: float, head
 
 def grown(grid: Grid, extra_cells: int, axis: int = 2) -> Grid:
     """The same grid with ``extra_cells`` more node layers at the high end of ``axis`` (2: on top, 0: past
-    the far end): every existing node keeps its (i, j, k) and its position, since the origin stays put."""
+    the far end, 1: past the side face y = R): every existing node keeps its (i, j, k) and its position, since
+    the origin stays put."""
     if extra_cells < 1:
         raise ValueError(f"extra_cells = {extra_cells} must be >= 1")
-    if axis not in (0, 2):
-        raise ValueError(f"axis = {axis} must be 0 (x, the far end) or 2 (z, the top)")
+    if axis not in (0, 1, 2):
+        raise ValueError(f"axis = {axis} must be 0 (x, the far end), 1 (y, the side) or 2 (z, the top)")
     shape = list(grid.shape)
     shape[axis] += extra_cells
     return Grid(origin=grid.origin, dx=grid.dx, shape=(shape[0], shape[1], shape[2]))
@@ -71,7 +72,7 @@ def extend_node_array(data: np.ndarray, shape: tuple[int, int, int], extra_cells
     """Node data of a grid of ``shape`` (flat nodes along array ``axis``) laid out on the grid with
     ``extra_cells`` more layers at the high end of ``grid_axis`` (:func:`grown`). The new layers hold
     ``fill``, or with ``fill`` None a copy of the old last layer (for the boundary flags: above the
-    surface they depend on y alone, along x on y and z alone)."""
+    surface they depend on y alone, along x on y and z alone, and past the side face y = R on z alone)."""
     data = np.ascontiguousarray(data)
     pre, post = data.shape[:axis], data.shape[axis + 1:]
     new_shape = list(shape)

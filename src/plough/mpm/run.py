@@ -140,7 +140,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     stopper = SteadyStop(scene) if scene.sliding.stop_when_steady else None
     slid_distance = scene.sliding.distance_m
     active_particle_steps = 0
-    raises_told = extensions_told = 0
+    raises_told = extensions_told = widenings_told = 0
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
@@ -170,6 +170,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                 step_no, slid_m, end_m = state.grid_extensions[-1]
                 bar.write(f"{scene.name}: material passed the grid's far end at step {step_no} ({slid_m * 1e6:.1f} "
                           f"um slid); the grid lengthened to x = {end_m * 1e6:.1f} um")
+            if bar is not None and len(state.grid_widenings) > widenings_told:
+                widenings_told = len(state.grid_widenings)
+                step_no, slid_m, side_m = state.grid_widenings[-1]
+                bar.write(f"{scene.name}: material passed the grid's side at step {step_no} ({slid_m * 1e6:.1f} "
+                          f"um slid); the grid widened to y = {side_m * 1e6:.1f} um")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)
     finally:
@@ -189,7 +194,8 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
             "active_fraction": active_particle_steps / max(n * state.step, 1),
             "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads(),
             "grid_top_m": float(const.grid_hi[2]), "grid_top_raises": len(state.grid_raises),
-            "grid_end_m": float(const.grid_hi[0]), "grid_end_extensions": len(state.grid_extensions)}
+            "grid_end_m": float(const.grid_hi[0]), "grid_end_extensions": len(state.grid_extensions),
+            "grid_side_m": float(const.grid_hi[1]), "grid_side_widenings": len(state.grid_widenings)}
     ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
                           rec.max_penetration, coating_row, slid_distance_m=slid_distance)
     warn_if_unsteady(ds, scene.name)

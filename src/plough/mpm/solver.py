@@ -23,8 +23,9 @@ index ranges; the material beyond is frozen and clamps the active part.
 
 Material that rises past the grid's top (a prow that keeps growing) raises it mid-run where the
 scene leaves the headroom automatic (:func:`raise_grid_top`), and material flung past the block's far
-end (fragments of a soft coating's chip) lengthens it (:func:`lengthen_grid`); any other particle
-leaving the grid, and a hand-set headroom, stop the run (:func:`check_stability`).
+end (fragments of a soft coating's chip) lengthens it (:func:`lengthen_grid`), and material thrown out
+through the side face y = R widens it there (:func:`widen_grid`); any other particle leaving the grid, and
+a hand-set headroom, stop the run (:func:`check_stability`).
 """
 
 from __future__ import annotations
@@ -72,9 +73,13 @@ GRID_TOP_LIMIT_RADII = 2.0
 #: radii: a soft coating's chip sheds fragments the 1e6 mass scaling flings ahead of the sphere (H~ = 0.25 at
 #: h = 5 um: up to 377 um ahead, at 4.5x the slide speed, README *Status*); they stay in the run
 GRID_END_LIMIT_RADII = 2.0
-#: each lengthening adds room for the farthest particle plus this many sphere radii, so that fragments
-#: flying on do not reallocate the grid every few steps
+#: each lengthening (and widening) adds room for the farthest particle plus this many sphere radii, so that
+#: fragments flying on do not reallocate the grid every few steps
 GRID_END_STEP_RADII = 0.25
+#: with the automatic headroom the grid also widens past the block's side face y = R (the high side; with
+#: the mirror plane the only one), up to this many sphere radii: the f = 0.5 coated run at h = 2.5 um threw a
+#: coating particle out through it, 13 um above the surface, 567.5 um into a 600 um slide (README *Status*)
+GRID_SIDE_LIMIT_RADII = 2.0
 
 
 class SimulationError(RuntimeError):
@@ -101,7 +106,8 @@ class SphereState:
 @dataclass
 class Constants:
     """Everything a step needs that does not change during a run, but for the grid (``grid``, ``shape``,
-    ``grid_hi``) when its top is raised (:func:`raise_grid_top`) or it is lengthened (:func:`lengthen_grid`)."""
+    ``grid_hi``) when its top is raised (:func:`raise_grid_top`), it is lengthened (:func:`lengthen_grid`) or
+    widened (:func:`widen_grid`)."""
 
     dt: float
     grid: Grid
@@ -136,7 +142,10 @@ class Constants:
     grid_top_limit_m: float = 0.0
     #: m, the farthest the grid's far end may move to when material passes it (``lengthen_grid``); 0: never
     grid_end_limit_m: float = 0.0
+    #: m, the farthest the grid's side (high y) may move to when material passes it (``widen_grid``); 0: never
+    grid_side_limit_m: float = 0.0
     block_end_m: float = 0.0  # m, x of the block's far end face (the grid starts a few cells past it)
+    block_side_m: float = 0.0  # m, y of the block's side face, its radius R (the grid starts a few cells past it)
 
 
 @dataclass
@@ -196,6 +205,8 @@ class State:
     grid_raises: list[tuple[int, float, float]] = field(default_factory=list)
     #: (step, sliding distance m, new grid end m) of each lengthening past the far end (``lengthen_grid``)
     grid_extensions: list[tuple[int, float, float]] = field(default_factory=list)
+    #: (step, sliding distance m, new grid side m) of each widening past the side face (``widen_grid``)
+    grid_widenings: list[tuple[int, float, float]] = field(default_factory=list)
 
 
 # ----------------------------------------------------------------------------- set-up
@@ -286,7 +297,9 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         grid_top_limit_m=GRID_TOP_LIMIT_RADII * r if scene.domain.headroom_m is None else 0.0,
         grid_end_limit_m=(scene.domain.length_m + GRID_END_LIMIT_RADII * r if scene.domain.headroom_m is None
                           else 0.0),
-        block_end_m=scene.domain.length_m,
+        grid_side_limit_m=(scene.domain.radius_m + GRID_SIDE_LIMIT_RADII * r if scene.domain.headroom_m is None
+                           else 0.0),
+        block_end_m=scene.domain.length_m, block_side_m=scene.domain.radius_m,
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
@@ -476,7 +489,8 @@ CAUSES = {
 def check_stability(s: State, c: Constants) -> None:
     """Stop at once, naming the step, the sliding distance and the likely cause; a particle past an
     automatic grid top raises the top (:func:`raise_grid_top`), one past the block's far end lengthens
-    the grid (:func:`lengthen_grid`), where that holds every particle and fits in memory."""
+    the grid (:func:`lengthen_grid`), one past its side widens it (:func:`widen_grid`), where that holds
+    every particle and fits in memory."""
     acc = s.work.acc
     bad = int(acc[:, transfers.ACC_BAD].max())
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
@@ -502,6 +516,13 @@ def check_stability(s: State, c: Constants) -> None:
                      f"{c.block_end_m * 1e6:.1f} um), {ahead:.1f} um ahead of the sphere's centre: material the sphere "
                      "pushes ahead of it (a prow or chip of a soft coating: lengthen domain.length_m) or a particle "
                      f"flung off the surface (lower mass_scaling or speed){limit}")
+        elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 1] > c.grid_hi[1]:
+            limit = (f"; the grid widens past the block's side by {GRID_SIDE_LIMIT_RADII:g} sphere radii at most, "
+                     f"to y = {c.grid_side_limit_m * 1e6:.1f} um" if c.grid_side_limit_m > 0.0 else "")
+            cause = (f"a particle moved out through the grid's side (y = {c.grid_hi[1] * 1e6:.1f} um; the block's "
+                     f"side is at {c.block_side_m * 1e6:.1f} um): material the sphere throws sideways (a prow or "
+                     "chip of a soft coating: enlarge domain.radius_m) or a particle flung off the surface (lower "
+                     f"mass_scaling or speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
             zone = s.zone
             cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo_m[0] * 1e6:.1f}.."
@@ -518,46 +539,53 @@ def check_stability(s: State, c: Constants) -> None:
 
 
 def _grow_to_hold(s: State, c: Constants, index: int) -> int:
-    """Raise the grid's top and lengthen it past the far end as far as the particles outside need and the
-    limits allow; the particle still outside afterwards (``index`` where nothing grew), -1 if none.
+    """Raise the grid's top, lengthen it past the far end and widen it past the side as far as the particles
+    outside need and the limits allow; the particle still outside afterwards (``index`` where nothing grew),
+    -1 if none.
 
-    Both are sized on this step's particles before either grows: the raise first, its wanted room counted
-    against the memory together with the lengthening that follows (which then checks itself). Nothing grows
-    where a particle is outside for a reason no growth mends (:func:`_outside_for_good`): the run stops on it."""
+    All are sized on this step's particles before any grows: the raise first, its wanted room counted against
+    the memory together with the growths that follow (each of which then checks itself). Nothing grows where a
+    particle is outside for a reason no growth mends (:func:`_outside_for_good`): the run stops on it."""
     stuck = _outside_for_good(s, c)
     if stuck >= 0:
         return stuck
     z = s.zone
     top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
-    lengthen = _layers_past_end(s, c)
-    if top > c.grid_hi[2] and raise_grid_top(s, c, then=((0, lengthen),) if lengthen else ()):
+    lengthen = _layers_past(s, c, 0, c.grid_end_limit_m)
+    widen = _layers_past(s, c, 1, c.grid_side_limit_m)
+    after_raise = tuple((axis, n) for axis, n in ((0, lengthen), (1, widen)) if n)
+    if top > c.grid_hi[2] and raise_grid_top(s, c, then=after_raise):
         index = _outside_index(s)
-    if index >= 0 and lengthen and lengthen_grid(s, c):
+    if index >= 0 and lengthen and lengthen_grid(s, c, then=((1, widen),) if widen else ()):
+        index = _outside_index(s)
+    if index >= 0 and widen and widen_grid(s, c):
         index = _outside_index(s)
     return index
 
 
 def _outside_for_good(s: State, c: Constants) -> int:
-    """An active particle outside the positions check's box other than above the grid's top or past its far
-    end (through the bottom, a side, the near end, or out of the active zone's slabs), -1 if none."""
+    """An active particle outside the positions check's box other than above the grid's top, past its far
+    end or past its side where the grid may widen (through the bottom, the low side, the near end, the side
+    of a grid that does not widen, or out of the active zone's slabs), -1 if none."""
     z = s.zone
     x = s.particles.x[z.p_lo:z.p_hi]
     low = np.any(x < z.check_lo_m, axis=1)
-    side = x[:, 1] > z.check_hi_m[1]
+    side = x[:, 1] > z.check_hi_m[1] if c.grid_side_limit_m <= 0.0 else np.zeros(len(x), dtype=bool)
     zone = (x[:, 0] > z.check_hi_m[0]) & (x[:, 0] <= c.grid_hi[0])
     out = np.flatnonzero(low | side | zone)
     return int(z.p_lo + out[0]) if out.size else -1
 
 
-def _layers_past_end(s: State, c: Constants) -> int:
-    """Node layers a lengthening needs for the active particles past the grid's far end (one cell past the
-    farthest), 0 where none is past it or the grid cannot lengthen."""
-    if c.grid_end_limit_m <= 0.0:
+def _layers_past(s: State, c: Constants, axis: int, limit_m: float) -> int:
+    """Node layers a growth along ``axis`` (0: past the far end, 1: past the side) needs for the active
+    particles beyond the grid's interior there (one cell past the farthest), 0 where none is beyond it or
+    the grid cannot grow that way (``limit_m`` 0)."""
+    if limit_m <= 0.0:
         return 0
-    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 0].max())
-    if far <= c.grid_hi[0]:
+    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, axis].max())
+    if far <= c.grid_hi[axis]:
         return 0
-    return max(_layers_to(far + c.grid.dx, float(c.grid_hi[0]), c.grid.dx), 1)
+    return max(_layers_to(far + c.grid.dx, float(c.grid_hi[axis]), c.grid.dx), 1)
 
 
 def _layers_to(target_m: float, now_m: float, dx: float) -> int:
@@ -587,7 +615,7 @@ def raise_grid_top(s: State, c: Constants, then: tuple[tuple[int, int], ...] = (
     return True
 
 
-def lengthen_grid(s: State, c: Constants) -> bool:
+def lengthen_grid(s: State, c: Constants, then: tuple[tuple[int, int], ...] = ()) -> bool:
     """Lengthen the grid past the block's far end mid-run so that every active particle has room again
     (fragments of a soft coating's chip flung ahead of the sphere); False where the scene set its headroom
     by hand (a fixed grid) or the room would pass ``Constants.grid_end_limit_m``; stops the run
@@ -595,15 +623,37 @@ def lengthen_grid(s: State, c: Constants) -> bool:
 
     The room reaches one cell past the farthest particle plus ``GRID_END_STEP_RADII`` sphere radii, and stops
     at the limit. Past the block's end the nodes' flags depend on y and z alone (the curved surface, the
-    mirror plane), so the new x layers copy the old last one; see :func:`grow_grid`.
+    mirror plane), so the new x layers copy the old last one; see :func:`grow_grid`. ``then``: the growths
+    the same step makes next, counted against the memory (:func:`raise_grid_top`).
     """
     if c.grid_end_limit_m <= 0.0:
         return False
     far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 0].max())
     if not _grow_within(s, c, 0, far + c.grid.dx, far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius,
-                        c.grid_end_limit_m):
+                        c.grid_end_limit_m, then):
         return False
     s.grid_extensions.append((s.step, s.sphere.slid_m, float(c.grid_hi[0])))
+    return True
+
+
+def widen_grid(s: State, c: Constants) -> bool:
+    """Widen the grid past the block's side face y = R mid-run so that every active particle has room again
+    (material a soft coating's prow throws sideways); False where the scene set its headroom by hand (a fixed
+    grid) or the room would pass ``Constants.grid_side_limit_m``; stops the run (:func:`check_raise_memory`)
+    where it would not fit in memory.
+
+    The room reaches one cell past the farthest particle plus ``GRID_END_STEP_RADII`` sphere radii, and stops
+    at the limit. Past the side face the nodes' flags depend on z alone (fixed below the surface, the curved
+    face's outside; free above), so the new y layers copy the old last one; see :func:`grow_grid`. Only the
+    high side grows: with the mirror plane it is the only side; a full block's low side (y = -R) does not.
+    """
+    if c.grid_side_limit_m <= 0.0:
+        return False
+    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 1].max())
+    if not _grow_within(s, c, 1, far + c.grid.dx, far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius,
+                        c.grid_side_limit_m):
+        return False
+    s.grid_widenings.append((s.step, s.sphere.slid_m, float(c.grid_hi[1])))
     return True
 
 
@@ -628,7 +678,7 @@ def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float
 
 
 def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
-    """Add ``extra`` node layers at the high end of ``axis`` (2: the top, 0: past the far end).
+    """Add ``extra`` node layers at the high end of ``axis`` (2: the top, 0: past the far end, 1: past the side).
 
     The origin stays put, so every node keeps its (i, j, k) and position: the per-node arrays are copied
     into the grown layout (new layers empty, contact memory unpushed, flags copied from the old last layer)
@@ -646,7 +696,7 @@ def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
     w.last_push = extend_node_array(w.last_push, shape, extra, fill=contact.NEVER_PUSHED, grid_axis=axis)
     w.flags = extend_node_array(w.flags, shape, extra, grid_axis=axis)
     old_slab, new_slab = shape[1] * shape[2], new.shape[1] * new.shape[2]
-    if axis == 2:  # x-major: the zone's node range keeps its slabs, each slab taller
+    if axis in (1, 2):  # x-major: the zone's node range keeps its slabs, each slab taller or wider
         z.n_lo, z.n_hi = z.n_lo // old_slab * new_slab, z.n_hi // old_slab * new_slab
     else:  # the slabs keep their size; a zone that reached the old far end reaches the new one
         z.n_hi = new.n_nodes if z.n_hi == g.n_nodes else z.n_hi
@@ -696,9 +746,10 @@ def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, availa
         return
     peak = growth_bytes(s, shape, [(axis, extra), *then])
     if peak > available:
-        what = ("rose above the grid's top, and raising it" if axis == 2
-                else "passed the grid's far end, and lengthening it")
-        more = "".join(f" and then {'raising' if a == 2 else 'lengthening'} it by {n}" for a, n in then)
+        what = {2: "rose above the grid's top, and raising it", 0: "passed the grid's far end, and lengthening it",
+                1: "passed the grid's side, and widening it"}[axis]
+        verb = {2: "raising", 0: "lengthening", 1: "widening"}
+        more = "".join(f" and then {verb[a]} it by {n}" for a, n in then)
         raise InstabilityError(
             f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material {what} "
             f"by {extra} node layers{more} would hold {peak / 2**30:.3g} GiB, more than this machine's "
