@@ -461,15 +461,34 @@ def test_interface_default_and_expected_contact():
     assert 0 < dp < a < s.sphere.radius_m
 
 
+def test_wave_limit_is_cos_squared_of_the_leading_edge_angle_of_the_expected_contact():
+    """sin alpha = a / r of the analytical contact: 46.1 um on the uncoated reference scene (0.947), 65.1 um
+    on the coated one (0.894, between the f = 0.8 that settles and the f = 0.9 that does not, README)."""
+    for name, expected in (("uncoated_rigid_plastic", 0.947), ("coated_rigid_plastic", 0.894)):
+        s = Scene.from_dict(example_dict(name))
+        a, _ = s.expected_contact()
+        assert s.wave_limit_ratio == pytest.approx(1.0 - (a / s.sphere.radius_m) ** 2, rel=1e-12)
+        assert s.wave_limit_ratio == pytest.approx(expected, abs=5e-4), name
+    coated = Scene.from_dict(example_dict("coated_rigid_plastic"))
+    assert coated.with_(interface=ProportionalShear(f=0.9)).interface_sticks
+    assert not coated.with_(interface=ProportionalShear(f=0.8)).interface_sticks
+    # a heavier load widens the contact: a steeper leading edge, a lower limit
+    assert coated.with_(load_N=6.0).wave_limit_ratio < coated.wave_limit_ratio
+
+
 def test_interface_strength_ratio_says_when_the_contact_can_stick():
-    """tau / kappa of the top layer; sticking (tau = kappa on a perfectly plastic layer) is flagged in the
-    output, because mu then follows the simulated speed (README, Interface shear)."""
+    """tau / kappa of the top layer; at or above the wave limit on a perfectly plastic layer it is flagged in
+    the output, because mu then follows the simulated speed (README, Interface shear)."""
     f1 = Scene.from_dict(example_dict())  # uncoated 900 MPa, proportional f = 1
     assert f1.interface_strength_ratio == 1.0 and f1.interface_sticks
-    assert "drag" in io.interface_regime(f1)
+    assert "wedge" in io.interface_regime(f1) and "cos^2 alpha = 0.947" in io.interface_regime(f1)
     half = f1.with_(interface=ProportionalShear(f=0.5))
     assert half.interface_strength_ratio == 0.5 and not half.interface_sticks
     assert io.interface_regime(half).startswith("tau = 0.5 kappa")
+    assert "below the wave limit cos^2 alpha = 0.947" in io.interface_regime(half)
+    limit = f1.wave_limit_ratio
+    assert f1.with_(interface=ProportionalShear(f=limit)).interface_sticks
+    assert not f1.with_(interface=ProportionalShear(f=limit * (1 - 1e-9))).interface_sticks
     # constant tau = 450 MPa / (3 sqrt 3) = 86.6 MPa against kappa = 300 MPa / sqrt 3 = 173.2 MPa of the substrate
     const = f1.with_(interface=ConstantShear(H0_Pa=450e6))
     assert const.interface_strength_ratio == pytest.approx(0.5, rel=1e-12) and not const.interface_sticks

@@ -410,17 +410,21 @@ def coating_representation(scene: Scene) -> str:
 
 
 def interface_regime(scene: Scene) -> str:
-    """What the interface can do at this scene's strength: said in the output, since at tau = kappa on a
-    perfectly plastic layer mu follows the simulated speed without settling (``Scene.interface_sticks``)."""
+    """What the interface can do at this scene's strength: said in the output, since at or above the wave limit
+    on a perfectly plastic layer mu follows the simulated speed without settling (``Scene.interface_sticks``)."""
     ratio = scene.interface_strength_ratio
     if ratio is None:
         return "pressure-dependent interface shear (tau = Cp P^np, capped at the contacting material's kappa)"
+    limit = scene.wave_limit_ratio
     if scene.interface_sticks:
-        return ("tau = kappa of a perfectly plastic surface the sphere touches: the contact can stick and drag it "
-                "along; mu follows the simulated speed and mass scaling without settling (README, Interface shear)")
+        return (f"tau = {ratio:.3g} kappa of a perfectly plastic surface the sphere touches, at or above the wave "
+                f"limit cos^2 alpha = {limit:.3g} of the expected contact: no steady state, the contact sticks and "
+                "a wedge of the layer builds up ahead of the sphere; mu follows the simulated speed and mass "
+                "scaling without settling (README, Interface shear)")
     if ratio >= 1.0:
         return "tau capped at kappa of a strain-hardening surface (speed dependence not measured)"
-    return f"tau = {ratio:.3g} kappa (largest over the surfaces the sphere touches, at yield onset)"
+    return (f"tau = {ratio:.3g} kappa (largest over the surfaces the sphere touches, at yield onset; below the wave "
+            f"limit cos^2 alpha = {limit:.3g} of the expected contact)")
 
 
 def write_result(ds: xr.Dataset, path: str | Path) -> Path:
