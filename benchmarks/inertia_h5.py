@@ -74,7 +74,7 @@ def main() -> None:
             out.write_text(json.dumps(rows, indent=2) + "\n")
             continue
         rows[name] = {k: float(ds[k]) for k in ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration", "Fz_mean",
-                                                "mu_standard_error", "dp_standard_error", "mu_drift")}
+                                                "mu_standard_error", "dp_standard_error", "mu_drift") if k in ds}
         rows[name].update(wall_s=ds.attrs["cost_wall_time_s"], particles=int(ds.attrs["cost_particles"]),
                           steps=int(ds.attrs["cost_steps"]), inertia_number=s.inertia_number,
                           graded=args.graded, zone_contact_radii=args.zone,

@@ -148,10 +148,10 @@ def _run_mpm(args: argparse.Namespace) -> int:
 def _note_interface(scene: Scene) -> None:
     """Tell the user when the scene's mu will follow the simulated speed (``Scene.interface_sticks``)."""
     if scene.interface_sticks:
-        print(f"plough: note: the interface (tau = {scene.interface_strength_ratio:.3g} kappa) is at or above the "
-              f"wave limit cos^2 alpha = {scene.wave_limit_ratio:.3g} of the perfectly plastic surface: no steady "
-              "state, mu follows the simulated speed and mass scaling without settling (README, Interface shear)",
-              file=sys.stderr)
+        print(f"plough: note: the interface (tau = {scene.sticking_ratio:.3g} kappa) is at or above the wave limit "
+              f"cos^2 alpha = {scene.wave_limit_ratio:.3g} of a perfectly plastic surface: no steady state "
+              "expected, and mu measured to follow the simulated speed and mass scaling without settling (README, "
+              "Interface shear)", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -63,6 +63,23 @@ def test_a_number_of_sections_is_kept(scene):
     assert np.nanmin(z) == pytest.approx(-2e-6, rel=1e-12)
 
 
+def test_material_thrown_past_the_blocks_side_is_not_read_as_its_surface(scene):
+    """A particle high above the surface beyond y = R (the grid widens for it) is not folded into the last
+    y bin: the profile is that of the block without it."""
+    s = replace(scene, outputs=replace(scene.outputs, profile_sections=3))
+    p, _ = _grooved_block(s, lambda r: np.full(r.shape, 2e-6))
+    a, x_end = 50e-6, s.start_x_m + s.sliding.distance_m
+    y, z0, sections = residual_profiles(p, s, x_end, a)
+    thrown = np.array([[sections[1], s.domain.radius_m + 3e-6, 13e-6]])
+    q = SimpleNamespace(x=np.vstack([p.x, thrown]), J=np.ones(p.n + 1), vol0=np.append(p.vol0, p.vol0[0]), n=p.n + 1)
+    _, z1, _ = residual_profiles(q, s, x_end, a)
+    np.testing.assert_array_equal(z1, z0)
+    inside = q.x.copy()
+    inside[-1, 1] = s.domain.radius_m - 3e-6  # the same particle inside the block's width does count
+    _, z2, _ = residual_profiles(SimpleNamespace(x=inside, J=q.J, vol0=q.vol0, n=q.n), s, x_end, a)
+    assert z2[-1] > z0[-1]
+
+
 def test_coarse_particles_are_sampled_on_the_fine_columns():
     """A 2 h particle's top face gives four h-wide samples at its quarter points, at z + h J^(1/3)."""
     from plough.mpm.io import surface_samples

@@ -551,6 +551,37 @@ def test_a_particle_past_the_side_widens_the_automatic_grid_up_to_its_limit(tiny
     assert not state2.grid_widenings and const2.grid.shape == (nx, ny, nz)
 
 
+def test_a_widening_past_its_limit_stops_the_run_before_another_growth_on_that_step(tiny_scene):
+    """A particle out through the side beyond the limit and another above the top on one step: nothing grows
+    (the raise would be wasted on a run that stops), and the message names the side and its limit."""
+    state, const = solver.init(tiny_scene, n_chunks=1)
+    shape = const.grid.shape
+    _flag_above_the_top(state, const)
+    state.particles.x[9, 1] = const.grid_side_limit_m + const.grid.dx
+    with pytest.raises(solver.InstabilityError) as err:
+        solver.check_stability(state, const)
+    assert "out through the grid's side" in str(err.value) and "widens past the block's side" in str(err.value)
+    assert "particle 9 " in str(err.value)
+    assert const.grid.shape == shape and not (state.grid_raises or state.grid_widenings)
+
+
+def test_a_full_block_widens_at_its_high_side_with_its_own_flags(tiny_scene):
+    """Without the mirror plane the block spans y in [-R, R]: the high side widens with the flags of the wider
+    full grid; the low side does not grow (a particle out there stops the run)."""
+    scene = tiny_scene.with_(domain=replace(tiny_scene.domain, symmetric=False))
+    state, const = solver.init(scene, n_chunks=1)
+    shape = const.grid.shape
+    _flag_past_the_side(state, const)
+    solver.check_stability(state, const)
+    assert const.grid.shape[1] > shape[1] and len(state.grid_widenings) == 1
+    assert np.array_equal(state.work.flags, boundary_flags(const.grid, scene.domain.radius_m, False))
+    state.particles.x[7, 1] = const.grid_lo[1] - 0.2 * const.grid.dx
+    state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
+    with pytest.raises(solver.InstabilityError, match="particle 7 "):
+        solver.check_stability(state, const)
+    assert len(state.grid_widenings) == 1
+
+
 def test_three_growths_on_one_step_all_grow_and_share_the_memory(tiny_scene, monkeypatch):
     """A particle above the top, one past the far end and one past the side on one step: all three growths
     happen, and the memory check counts them together (a byte less than the three needed stops the run before

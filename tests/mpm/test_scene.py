@@ -474,6 +474,11 @@ def test_wave_limit_is_cos_squared_of_the_leading_edge_angle_of_the_expected_con
     assert not coated.with_(interface=ProportionalShear(f=0.8)).interface_sticks
     # a heavier load widens the contact: a steeper leading edge, a lower limit
     assert coated.with_(load_N=6.0).wave_limit_ratio < coated.wave_limit_ratio
+    # under displacement control the set depth cuts the contact: a^2 = 2 r d - d^2
+    d = 4e-6
+    held = coated.with_(sliding=replace(coated.sliding, control="displacement", depth_m=d))
+    r = coated.sphere.radius_m
+    assert held.wave_limit_ratio == pytest.approx(1.0 - (2 * r * d - d * d) / r**2, rel=1e-12)
 
 
 def test_interface_strength_ratio_says_when_the_contact_can_stick():
@@ -481,12 +486,13 @@ def test_interface_strength_ratio_says_when_the_contact_can_stick():
     the output, because mu then follows the simulated speed (README, Interface shear)."""
     f1 = Scene.from_dict(example_dict())  # uncoated 900 MPa, proportional f = 1
     assert f1.interface_strength_ratio == 1.0 and f1.interface_sticks
-    assert "wedge" in io.interface_regime(f1) and "cos^2 alpha = 0.947" in io.interface_regime(f1)
+    assert "prow" in io.interface_regime(f1) and "cos^2 alpha = 0.947" in io.interface_regime(f1)
     half = f1.with_(interface=ProportionalShear(f=0.5))
     assert half.interface_strength_ratio == 0.5 and not half.interface_sticks
     assert io.interface_regime(half).startswith("tau = 0.5 kappa")
     assert "below the wave limit cos^2 alpha = 0.947" in io.interface_regime(half)
     limit = f1.wave_limit_ratio
+    assert f1.sticking_ratio == 1.0 and half.sticking_ratio is None
     assert f1.with_(interface=ProportionalShear(f=limit)).interface_sticks
     assert not f1.with_(interface=ProportionalShear(f=limit * (1 - 1e-9))).interface_sticks
     # constant tau = 450 MPa / (3 sqrt 3) = 86.6 MPa against kappa = 300 MPa / sqrt 3 = 173.2 MPa of the substrate
@@ -506,6 +512,11 @@ def test_interface_strength_ratio_says_when_the_contact_can_stick():
     capped = zinc.with_(interface=ConstantShear(H0_Pa=450e6))  # tau 86.6 MPa above the zinc coating's kappa
     assert capped.interface_strength_ratio == 1.0 and not capped.interface_sticks
     assert "strain-hardening" in io.interface_regime(capped)
+    # between the wave limit and 1 on a hardening surface: not flagged, and not said to be below the limit
+    strong = zinc.with_(interface=ProportionalShear(f=0.99))
+    assert strong.wave_limit_ratio < 0.99 and not strong.interface_sticks and strong.sticking_ratio is None
+    text = io.interface_regime(strong)
+    assert "strain-hardening" in text and "at or above the wave limit" in text and "below" not in text
 
 
 def _coated_constant_scene(t_um: float, hc_MPa: float, hs_MPa: float, h_um: float = 10.0) -> Scene:

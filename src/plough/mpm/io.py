@@ -195,7 +195,8 @@ def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_ra
     sx, sy, top, _ = surface_samples(p, h)
     profiles = []
     for xs in sections:
-        band = np.abs(sx - xs) < 0.5 * h
+        # material thrown out past the block's side (the grid widens for it) is not the groove's surface
+        band = (np.abs(sx - xs) < 0.5 * h) & (sy <= edges[-1])
         idx = np.clip(np.digitize(sy[band], edges) - 1, 0, centres.size - 1)
         z = np.full(centres.size, -np.inf)
         np.maximum.at(z, idx, top[band])
@@ -291,7 +292,7 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
     for xs in sections:
         in_sections |= np.abs(sx - xs) < 0.5 * h
     half_edge = 0.5 * np.cbrt(p.vol0)
-    line = in_sections & (np.abs(p.z0 + depth) <= half_edge + 1e-12)[sample_of]
+    line = in_sections & (np.abs(p.z0 + depth) <= half_edge + 1e-12)[sample_of] & (sy <= y_edges[-1])
     iyl = np.clip(np.digitize(sy[line], y_edges) - 1, 0, y_edges.size - 2)
     total = np.bincount(iyl, weights=(z - p.z0)[sample_of[line]], minlength=y_edges.size - 1)
     count = np.bincount(iyl, minlength=y_edges.size - 1)
@@ -416,13 +417,15 @@ def interface_regime(scene: Scene) -> str:
     if ratio is None:
         return "pressure-dependent interface shear (tau = Cp P^np, capped at the contacting material's kappa)"
     limit = scene.wave_limit_ratio
-    if scene.interface_sticks:
-        return (f"tau = {ratio:.3g} kappa of a perfectly plastic surface the sphere touches, at or above the wave "
-                f"limit cos^2 alpha = {limit:.3g} of the expected contact: no steady state, the contact sticks and "
-                "a wedge of the layer builds up ahead of the sphere; mu follows the simulated speed and mass "
-                "scaling without settling (README, Interface shear)")
-    if ratio >= 1.0:
-        return "tau capped at kappa of a strain-hardening surface (speed dependence not measured)"
+    sticking = scene.sticking_ratio
+    if sticking is not None:
+        return (f"tau = {sticking:.3g} kappa of a perfectly plastic surface the sphere touches, at or above the wave "
+                f"limit cos^2 alpha = {limit:.3g} of the expected contact: no steady state expected (the contact "
+                "can stick and a prow of the layer build up ahead of the sphere); mu measured to follow the "
+                "simulated speed and mass scaling without settling (README, Interface shear)")
+    if ratio >= limit:
+        capped = "capped at kappa" if ratio >= 1.0 else f"= {ratio:.3g} kappa, at or above the wave limit {limit:.3g},"
+        return f"tau {capped} of a strain-hardening surface (not flagged; speed dependence not measured)"
     return (f"tau = {ratio:.3g} kappa (largest over the surfaces the sphere touches, at yield onset; below the wave "
             f"limit cos^2 alpha = {limit:.3g} of the expected contact)")
 

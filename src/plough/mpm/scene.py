@@ -208,8 +208,9 @@ class Domain:
     rise into (pile-up, and the prow an adhesive interface pushes up the sphere's front); None
     sizes it from the expected groove (``Scene.grid_headroom_m``) and lets the solver raise it
     mid-run where material reaches it (``solver.raise_grid_top``), and lengthen it past the block's
-    far end where material flung ahead passes it (``solver.lengthen_grid``); a value set here fixes
-    the whole grid, the top and the far end. It costs grid nodes, not particles.
+    far end where material flung ahead passes it (``solver.lengthen_grid``), and widen it past the side
+    face where material thrown sideways passes it (``solver.widen_grid``); a value set here fixes the whole
+    grid, the top, the far end and the side. It costs grid nodes, not particles.
     """
 
     radius_m: float = 200e-6
@@ -562,8 +563,8 @@ class Scene:
         the sphere sweeps ahead) outgrows any fixed rule, and one expected contact radius more would
         cost 9-22% more grid nodes at h <= 5 um on the reference scenes: with this automatic value
         the solver raises the grid's top mid-run where material reaches it
-        (``solver.raise_grid_top``) and lengthens the grid past the block's far end
-        (``solver.lengthen_grid``)."""
+        (``solver.raise_grid_top``), lengthens the grid past the block's far end
+        (``solver.lengthen_grid``) and widens it past the side face (``solver.widen_grid``)."""
         if self.domain.headroom_m is not None:
             return self.domain.headroom_m
         _, dp = self.expected_contact()
@@ -636,26 +637,40 @@ class Scene:
         plane-strain wave model (Wear 53, 1979), in the form usually quoted, the friction contains
         arcsin(sin alpha / sqrt(1 - f)), real only for f <= cos^2 alpha; above it their analysis gives
         wedge formation, material building up ahead of the asperity. (The formula was not checked against
-        the original here; the measured boundary below is what the flag rests on.)"""
-        a, _ = self.expected_contact()
-        s = min(a / self.sphere.radius_m, 1.0)
+        the original here; the measured boundary below is what the flag rests on.) Under displacement
+        control the contact is the one the set depth cuts, a^2 = 2 r d - d^2; otherwise the expected contact
+        of the load."""
+        r = self.sphere.radius_m
+        if self.sliding.control == "displacement" and self.sliding.depth_m is not None:
+            d = min(self.sliding.depth_m, r)
+            a = math.sqrt(2.0 * r * d - d * d)
+        else:
+            a, _ = self.expected_contact()
+        s = min(a / r, 1.0)
         return 1.0 - s * s
+
+    @property
+    def sticking_ratio(self) -> float | None:
+        """Largest tau / kappa over the perfectly plastic surfaces the sphere touches whose ratio is at or above
+        ``wave_limit_ratio``; None where there is none (``interface_sticks``)."""
+        limit = self.wave_limit_ratio
+        ratios = [r for r, plastic in self._surface_ratios() or [] if plastic and r >= limit]
+        return max(ratios) if ratios else None
 
     @property
     def interface_sticks(self) -> bool:
         """Whether the interface is strong enough on a perfectly plastic surface the sphere touches that no
-        steady state exists: tau / kappa at or above ``wave_limit_ratio``.
+        steady state is expected: tau / kappa at or above ``wave_limit_ratio`` (``sticking_ratio``).
 
         The contact then sticks and drags the layer just below the surface along, a wedge of it builds
         up ahead of the sphere, and mu follows the simulated speed and mass scaling without settling
         (README, *Interface shear*). Measured on the coated rigid-plastic scene at h = 20 um, down to
-        1/256 of the paper's inertia: mu settles at f = 0.5, 0.7 and 0.8 and wanders by +-7 to 13% at
+        1/256 of the paper's inertia: mu settles at f = 0.5, 0.7 and 0.8 and wanders by +-6 to 9% at
         f = 0.9, 0.95 and 1, where ``wave_limit_ratio`` is 0.894; at h = 10 and 5 um the f = 1 runs rise
         with the simulated time (f = 0.5 settles). A hardening layer is not flagged: its strength grows
         under the sphere (not measured).
         """
-        limit = self.wave_limit_ratio
-        return any(r >= limit and plastic for r, plastic in self._surface_ratios() or [])
+        return self.sticking_ratio is not None
 
     @property
     def start_x_m(self) -> float:

@@ -550,17 +550,25 @@ def _grow_to_hold(s: State, c: Constants, index: int) -> int:
     if stuck >= 0:
         return stuck
     z = s.zone
-    top = float(s.particles.x[z.p_lo:z.p_hi, 2].max())
+    x = s.particles.x[z.p_lo:z.p_hi]
     lengthen = _layers_past(s, c, 0, c.grid_end_limit_m)
     widen = _layers_past(s, c, 1, c.grid_side_limit_m)
-    after_raise = tuple((axis, n) for axis, n in ((0, lengthen), (1, widen)) if n)
-    if top > c.grid_hi[2] and raise_grid_top(s, c, then=after_raise):
-        index = _outside_index(s)
-    if index >= 0 and lengthen and lengthen_grid(s, c, then=((1, widen),) if widen else ()):
-        index = _outside_index(s)
-    if index >= 0 and widen and widen_grid(s, c):
-        index = _outside_index(s)
-    return index
+    # a particle past a face that cannot grow as far stops the run before anything grows: it is the one named
+    for axis, layers in ((0, lengthen), (1, widen)):
+        far = int(np.argmax(x[:, axis]))
+        if x[far, axis] > c.grid_hi[axis] and not layers:
+            return z.p_lo + far
+    top = int(np.argmax(x[:, 2]))
+    if x[top, 2] > c.grid_hi[2]:
+        if not raise_grid_top(s, c, then=tuple((axis, n) for axis, n in ((0, lengthen), (1, widen)) if n)):
+            return z.p_lo + top
+    elif not (lengthen or widen):
+        return index  # nothing to grow: the particle the kernel flagged
+    if lengthen:
+        lengthen_grid(s, c, then=((1, widen),) if widen else ())
+    if widen:
+        widen_grid(s, c)
+    return _outside_index(s)
 
 
 def _outside_for_good(s: State, c: Constants) -> int:
@@ -578,14 +586,16 @@ def _outside_for_good(s: State, c: Constants) -> int:
 
 def _layers_past(s: State, c: Constants, axis: int, limit_m: float) -> int:
     """Node layers a growth along ``axis`` (0: past the far end, 1: past the side) needs for the active
-    particles beyond the grid's interior there (one cell past the farthest), 0 where none is beyond it or
-    the grid cannot grow that way (``limit_m`` 0)."""
+    particles beyond the grid's interior there (one cell past the farthest), 0 where none is beyond it, the
+    grid cannot grow that way (``limit_m`` 0) or the room needed would pass ``limit_m``."""
     if limit_m <= 0.0:
         return 0
     far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, axis].max())
-    if far <= c.grid_hi[axis]:
+    now = float(c.grid_hi[axis])
+    if far <= now:
         return 0
-    return max(_layers_to(far + c.grid.dx, float(c.grid_hi[axis]), c.grid.dx), 1)
+    need = max(_layers_to(far + c.grid.dx, now, c.grid.dx), 1)
+    return need if need <= math.floor((limit_m - now) / c.grid.dx + 1e-9) else 0
 
 
 def _layers_to(target_m: float, now_m: float, dx: float) -> int:
