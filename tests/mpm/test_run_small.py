@@ -471,6 +471,22 @@ def _assert_same_run(a, b, scene):
     assert np.abs(a.particles.x - solver.init(scene, n_chunks=1)[0].particles.x).max() > 1e-7
 
 
+def _grown_at_start_and_both_run_on(scene, late, c_late, axis, extra):
+    """The same scene grown by ``extra`` layers along ``axis`` at step 0 (flags those of the grown grid); then
+    both it and ``late`` (grown mid-run) step on to 150 steps past ``late``'s step. Returns the one grown at
+    the start."""
+    start, c_start = solver.init(scene, n_chunks=1)
+    solver.grow_grid(start, c_start, axis, extra)
+    assert c_start.grid.shape == c_late.grid.shape
+    assert np.array_equal(start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
+    for _ in range(late.step + 150 - start.step):
+        solver.step(start, c_start)
+    for _ in range(150):
+        solver.step(late, c_late)
+    assert start.step == late.step
+    return start, c_start
+
+
 @pytest.mark.parametrize("zone", [None, 2.0], ids=["whole block", "active zone"])
 def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_longer_grid(tiny_scene, zone):
     """Lengthened mid-slide (contact memory and grid buffers in use, the zone at the block's end) against
@@ -480,15 +496,7 @@ def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_lon
     while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6 and late.zone.p_hi == late.particles.n):
         solver.step(late, c_late)  # until the zone reached the block's end: it must follow the new end
     solver.grow_grid(late, c_late, 0, 6)
-    start, c_start = solver.init(scene, n_chunks=1)
-    solver.grow_grid(start, c_start, 0, 6)
-    assert c_start.grid.shape == c_late.grid.shape
-    assert np.array_equal(start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
-    for _ in range(late.step + 150 - start.step):
-        solver.step(start, c_start)
-    for _ in range(150):
-        solver.step(late, c_late)
-    assert start.step == late.step
+    start, c_start = _grown_at_start_and_both_run_on(scene, late, c_late, 0, 6)
     assert late.zone.n_hi == start.zone.n_hi == c_late.grid.n_nodes
     assert late.zone.check_hi_m[0] == start.zone.check_hi_m[0] == c_late.grid_hi[0]
     _assert_same_run(late, start, scene)
@@ -617,15 +625,7 @@ def test_a_run_whose_grid_was_widened_goes_on_as_if_it_had_started_on_the_wider_
     solver.grow_grid(late, c_late, 1, 5)
     new_slab = c_late.grid.shape[1] * c_late.grid.shape[2]
     assert (late.zone.n_lo, late.zone.n_hi) == (slabs[0] // old_slab * new_slab, slabs[1] // old_slab * new_slab)
-    start, c_start = solver.init(scene, n_chunks=1)
-    solver.grow_grid(start, c_start, 1, 5)
-    assert c_start.grid.shape == c_late.grid.shape
-    assert np.array_equal(start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
-    for _ in range(late.step + 150 - start.step):
-        solver.step(start, c_start)
-    for _ in range(150):
-        solver.step(late, c_late)
-    assert start.step == late.step
+    start, c_start = _grown_at_start_and_both_run_on(scene, late, c_late, 1, 5)
     assert (late.zone.n_lo, late.zone.n_hi) == (start.zone.n_lo, start.zone.n_hi)
     assert (late.zone.p_hi - late.zone.p_lo < late.particles.n) == (zone is not None)
     assert late.zone.check_hi_m[1] == start.zone.check_hi_m[1] == c_late.grid_hi[1]

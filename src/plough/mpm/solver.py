@@ -510,15 +510,13 @@ def check_stability(s: State, c: Constants) -> None:
                      f"particle flung off the surface (lower mass_scaling or speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 0] > c.grid_hi[0]:
             ahead = (s.particles.x[index, 0] - s.sphere.centre[0]) * 1e6
-            limit = (f"; the grid lengthens past the block's end by {GRID_END_LIMIT_RADII:g} sphere radii at most, "
-                     f"to x = {c.grid_end_limit_m * 1e6:.1f} um" if c.grid_end_limit_m > 0.0 else "")
+            limit = _growth_limit_note("lengthens past the block's end", GRID_END_LIMIT_RADII, "x", c.grid_end_limit_m)
             cause = (f"a particle moved past the grid's far end (x = {c.grid_hi[0] * 1e6:.1f} um; the block ends at "
                      f"{c.block_end_m * 1e6:.1f} um), {ahead:.1f} um ahead of the sphere's centre: material the sphere "
                      "pushes ahead of it (a prow or chip of a soft coating: lengthen domain.length_m) or a particle "
                      f"flung off the surface (lower mass_scaling or speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 1] > c.grid_hi[1]:
-            limit = (f"; the grid widens past the block's side by {GRID_SIDE_LIMIT_RADII:g} sphere radii at most, "
-                     f"to y = {c.grid_side_limit_m * 1e6:.1f} um" if c.grid_side_limit_m > 0.0 else "")
+            limit = _growth_limit_note("widens past the block's side", GRID_SIDE_LIMIT_RADII, "y", c.grid_side_limit_m)
             cause = (f"a particle moved out through the grid's side (y = {c.grid_hi[1] * 1e6:.1f} um; the block's "
                      f"side is at {c.block_side_m * 1e6:.1f} um): material the sphere throws sideways (a prow or "
                      "chip of a soft coating: enlarge domain.radius_m) or a particle flung off the surface (lower "
@@ -536,6 +534,13 @@ def check_stability(s: State, c: Constants) -> None:
         raise InstabilityError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
                               f"by the sphere ({s.work.external_work:.3g} J): inertia dominates; lower "
                               "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")
+
+
+def _growth_limit_note(what: str, radii: float, axis_name: str, limit_m: float) -> str:
+    """'; the grid <what> by <radii> sphere radii at most, to <axis> = <limit> um', or '' for a fixed grid."""
+    if limit_m <= 0.0:
+        return ""
+    return f"; the grid {what} by {radii:g} sphere radii at most, to {axis_name} = {limit_m * 1e6:.1f} um"
 
 
 def _grow_to_hold(s: State, c: Constants, index: int) -> int:
