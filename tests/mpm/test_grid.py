@@ -56,8 +56,14 @@ def test_a_taller_grid_keeps_every_node_where_it_was_and_its_data_with_it():
     assert np.array_equal(top[:, :, nz + 3], top[:, :, nz - 1])  # fill None: the old top layer again
     with pytest.raises(ValueError, match="extra_cells = 0"):
         grown(g, 0)
-    with pytest.raises(ValueError, match="axis = 1 must be 0"):
-        grown(g, 2, axis=1)
+    with pytest.raises(ValueError, match=r"axis = 3 must be 0 \(x, the far end\), 1 \(y, the side\) or 2"):
+        grown(g, 2, axis=3)
+    wide = grown(g, 3, axis=1)  # past the side face: every node keeps its (i, j, k) and position
+    assert wide.shape == (nx, ny + 3, nz) and np.array_equal(wide.origin, g.origin)
+    assert np.array_equal(wide.node_positions().reshape(nx, ny + 3, nz, 3)[:, :ny], old_pos)
+    side = extend_node_array(data, g.shape, 3, fill=None, grid_axis=1).reshape(nx, ny + 3, nz, 2)
+    assert np.array_equal(side[:, :ny], data.reshape(nx, ny, nz, 2))
+    assert np.array_equal(side[:, ny + 2], side[:, ny - 1])
 
 
 def test_a_longer_grid_keeps_every_node_where_it_was_and_its_flags_are_the_longer_grids_own():
