@@ -70,7 +70,7 @@ def test_material_thrown_past_the_blocks_side_is_not_read_as_its_surface(scene):
     p, _ = _grooved_block(s, lambda r: np.full(r.shape, 2e-6))
     a, x_end = 50e-6, s.start_x_m + s.sliding.distance_m
     y, z0, sections = residual_profiles(p, s, x_end, a)
-    thrown = np.array([[sections[1], s.domain.radius_m + 3e-6, 13e-6]])
+    thrown = np.array([[sections[1], s.domain.radius_m + 0.6 * s.discretisation.particle_size_m, 13e-6]])
     q = SimpleNamespace(x=np.vstack([p.x, thrown]), J=np.ones(p.n + 1), vol0=np.append(p.vol0, p.vol0[0]), n=p.n + 1)
     _, z1, _ = residual_profiles(q, s, x_end, a)
     np.testing.assert_array_equal(z1, z0)

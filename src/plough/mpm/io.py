@@ -130,6 +130,13 @@ def _y_edges(scene: Scene) -> np.ndarray:
     return np.arange(0.0 if scene.domain.symmetric else -y_max, y_max + 0.5 * h, h)
 
 
+def within_block_width(y: np.ndarray, scene: Scene) -> np.ndarray:
+    """Samples within the block's width, |y| <= R + h / 2: material thrown out past the side face (the grid
+    widens for it, ``solver.widen_grid``) is not the groove's surface, whereas a column near the face still is
+    (it goes to the last y bin, as before)."""
+    return np.abs(y) <= scene.domain.radius_m + 0.5 * scene.discretisation.particle_size_m
+
+
 def surface_samples(p: Particles, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(x, y, top, index) with one sample per h x h column of every particle's top face.
 
@@ -193,10 +200,10 @@ def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_ra
     edges = _y_edges(scene)
     centres = 0.5 * (edges[1:] + edges[:-1])
     sx, sy, top, _ = surface_samples(p, h)
+    inside = within_block_width(sy, scene)
     profiles = []
     for xs in sections:
-        # material thrown out past the block's side (the grid widens for it) is not the groove's surface
-        band = (np.abs(sx - xs) < 0.5 * h) & (sy <= edges[-1])
+        band = (np.abs(sx - xs) < 0.5 * h) & inside
         idx = np.clip(np.digitize(sy[band], edges) - 1, 0, centres.size - 1)
         z = np.full(centres.size, -np.inf)
         np.maximum.at(z, idx, top[band])
@@ -292,7 +299,7 @@ def picture_variables(p: Particles, scene: Scene, sphere_centre: np.ndarray, coa
     for xs in sections:
         in_sections |= np.abs(sx - xs) < 0.5 * h
     half_edge = 0.5 * np.cbrt(p.vol0)
-    line = in_sections & (np.abs(p.z0 + depth) <= half_edge + 1e-12)[sample_of] & (sy <= y_edges[-1])
+    line = in_sections & (np.abs(p.z0 + depth) <= half_edge + 1e-12)[sample_of] & within_block_width(sy, scene)
     iyl = np.clip(np.digitize(sy[line], y_edges) - 1, 0, y_edges.size - 2)
     total = np.bincount(iyl, weights=(z - p.z0)[sample_of[line]], minlength=y_edges.size - 1)
     count = np.bincount(iyl, minlength=y_edges.size - 1)
