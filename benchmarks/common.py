@@ -18,6 +18,20 @@ def coated_reference(h_um: float) -> Scene:
     return replace(base, discretisation=replace(base.discretisation, particle_size_m=h_um * 1e-6)).with_sized_domain()
 
 
+#: the example scenes a benchmark names by a short key (``real``, ``coated``, ``uncoated``)
+EXAMPLES = {"real": "zinc_coated_steel.yaml", "coated": "coated_rigid_plastic.yaml",
+            "uncoated": "uncoated_rigid_plastic.yaml"}
+
+
+def workflow_scene(name: str, h_m: float) -> Scene:
+    """The example scene ``name`` (a key of ``EXAMPLES``) at particle size ``h_m`` with the workflow's
+    numerics (config/config.yaml): graded particles, fine zone 1.5 contact radii, active zone of 4, sized block."""
+    base = Scene.from_yaml(ROOT / "examples" / EXAMPLES[name])
+    disc = replace(base.discretisation, particle_size_m=h_m, graded=True, fine_zone_contact_radii=1.5,
+                   active_zone_contact_radii=4.0)
+    return replace(base, discretisation=disc).with_sized_domain()
+
+
 #: the steady-state results a benchmark row keeps of a run
 RESULTS = ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration", "Fz_mean")
 

@@ -6,7 +6,7 @@ The particle lattice and the grid are anchored at x = 0 and the sphere starts at
 block minus half the slide. Lengthening the block by 2 phi h moves the start by phi h against the
 lattice while the slide, the steady window and everything else stay the same: a change with no
 physical meaning. Each case runs the scene with the workflow's numerics (graded particles, fine zone
-1.5 contact radii, active zone of 4, sized block; as ``roundoff_sensitivity.py``) at phases
+1.5 contact radii, active zone of 4, sized block; ``common.workflow_scene``) at phases
 phi = 0, 1/N, ..., (N-1)/N. The spread of mu and dp over the phases is the noise floor of a single
 run: two settings whose results differ by less than it cannot be told apart with one run each. It
 is set beside each run's own sampling error (``mu_standard_error``, ``dp_standard_error``: the
@@ -25,7 +25,7 @@ from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
-from roundoff_sensitivity import workflow_scene
+from common import workflow_scene
 
 from plough.io import git_commit
 from plough.mpm.run import simulate
