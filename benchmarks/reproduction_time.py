@@ -10,8 +10,8 @@ Also projected: the lower bound with `mpm.skip_finest_tolerance` set, when every
 run is skipped (the pictures' finest runs always run); how many are skipped depends on the results.
 With ``numerics.graded`` on, the particle counts are the graded ones and the throughput is scaled
 by the graded runs' particle-steps per second over the uniform runs' at the same scene and size
-(median over benchmarks/results/graded_particles.json, fine zone as configured): a graded run has
-fewer particles on the same grid, so the grid's share of a step grows.
+(median over docs/journal/2026-11-22-graded-particles/graded_particles.json, fine zone as
+configured): a graded run has fewer particles on the same grid, so the grid's share of a step grows.
 With ``numerics.active_zone_contact_radii`` set, each run's particle-steps are those its active
 zone works on (plough.study.cost), and the throughput is scaled by the zoned runs' particle-steps
 worked on per second over the same scenes' runs without a zone (median over
@@ -61,8 +61,8 @@ def graded_throughput_ratio(path: Path, k: float) -> float:
                 rate = [r["particles"] * r["steps"] / r["wall_s"] for r in (graded, uniform)]
                 ratios.append(rate[0] / rate[1])
     if not ratios:
-        raise SystemExit(f"{path} has no graded run with fine_zone_contact_radii = {k:g}: run "
-                         "benchmarks/graded_particles.py first")
+        raise SystemExit(f"{path} has no graded run with fine_zone_contact_radii = {k:g} (the file of "
+                         "docs/journal/2026-11-22-graded-particles.md has 1.5 and 1)")
     return statistics.median(ratios)
 
 
@@ -80,7 +80,8 @@ def zone_throughput_ratio(path: Path, k: float) -> float:
 def add_measured_arguments(parser: argparse.ArgumentParser) -> None:
     """The measured results files the throughput model reads (shared with projection_check.py)."""
     parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
-    parser.add_argument("--graded-measured", default=str(ROOT / "benchmarks" / "results" / "graded_particles.json"))
+    parser.add_argument("--graded-measured", default=str(ROOT / "docs" / "journal" / "2026-11-22-graded-particles"
+                                                         / "graded_particles.json"))
     parser.add_argument("--zone-measured", default=str(ROOT / "benchmarks" / "results" / "active_zone.json"))
     parser.add_argument("--material-measured", default=str(ROOT / "benchmarks" / "results" / "material_cost.json"))
 
