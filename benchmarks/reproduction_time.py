@@ -15,7 +15,7 @@ configured): a graded run has fewer particles on the same grid, so the grid's sh
 With ``numerics.active_zone_contact_radii`` set, each run's particle-steps are those its active
 zone works on (plough.study.cost), and the throughput is scaled by the zoned runs' particle-steps
 worked on per second over the same scenes' runs without a zone (median over
-benchmarks/results/active_zone.json, zone as configured).
+docs/journal/2026-11-23-active-zone/active_zone.json, zone as configured).
 Runs whose layers use the real materials' flow laws (hardening, rate terms, heating: Figs. 14-23)
 go at the real-materials' share of the constant-flow throughput measured on the same block
 (benchmarks/results/material_cost.json, ``benchmarks/material_cost.py``); the rigid-plastic runs
@@ -72,8 +72,8 @@ def zone_throughput_ratio(path: Path, k: float) -> float:
     ratios = [rows[f"zone {k:g}"]["active_fraction"] * rows["all"]["wall_s"] / rows[f"zone {k:g}"]["wall_s"]
               for rows in runs.values() if f"zone {k:g}" in rows and "all" in rows]
     if not ratios:
-        raise SystemExit(f"{path} has no run with active_zone_contact_radii = {k:g}: "
-                         "run benchmarks/active_zone.py first")
+        raise SystemExit(f"{path} has no run with active_zone_contact_radii = {k:g} (the file of "
+                         "docs/journal/2026-11-23-active-zone.md has 3, 4 and 6)")
     return statistics.median(ratios)
 
 
@@ -82,7 +82,8 @@ def add_measured_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--measured", default=str(ROOT / "benchmarks" / "results" / "mpm_reference_sized.json"))
     parser.add_argument("--graded-measured", default=str(ROOT / "docs" / "journal" / "2026-11-22-graded-particles"
                                                          / "graded_particles.json"))
-    parser.add_argument("--zone-measured", default=str(ROOT / "benchmarks" / "results" / "active_zone.json"))
+    parser.add_argument("--zone-measured", default=str(ROOT / "docs" / "journal" / "2026-11-23-active-zone"
+                                                       / "active_zone.json"))
     parser.add_argument("--material-measured", default=str(ROOT / "benchmarks" / "results" / "material_cost.json"))
 
 
