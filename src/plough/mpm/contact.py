@@ -40,8 +40,8 @@ Why not the earlier area min(F_n,i / P_i, dx^2) with a filtered F_n,i: P_i from 
 stress was 0.40 of the hardness at h = 10 um (the particles next to the sphere carry little of the
 contact pressure, the grid does), so 82% of the normal force sat on nodes whose area was capped at
 a face, and a node kept shear until its filtered force had faded, about 0.7 cell of sliding: mu_sh
-followed the filter time (+0.004 per wave transit; README, "Interface shear";
-benchmarks/contact_sensitivity.py). With this hold it does not (holds of 1-8 transits: +-1.2%).
+followed the filter time (+0.004 per wave transit; docs/journal/2026-11-22-contact-shear-area.md).
+With this hold it does not (holds of 1-8 transits: +-1.2%).
 """
 
 from __future__ import annotations
