@@ -11,7 +11,13 @@ the one that runs in production). Reports the median per-step time of each kerne
 steps, the Python overhead (step time minus the kernels), particle-steps per second, and the
 bytes a step must move per particle (particle state read and written by P2G and G2P, plus the
 grid traffic per particle), which with the triad bandwidth of ``../shared/peer-bench/bandwidth.py``
-gives the bandwidth bound. Writes benchmarks/results/kernel_profile_h<h>.json.
+gives the bandwidth bound. Writes ``--out`` (default
+benchmarks/results/kernel_profile[_<scene>]_h<h>[_paper_block].json).
+
+It patches module attributes, and only these: each wrapper calls the original kernel with the same
+arguments and returns its result, adding nothing but a clock read on either side, so the physics is
+that of a normal run (no constant, option or kernel is changed); the originals are put back after
+the timed steps, also on an error. Timing a kernel this way needs no option in the solver.
 """
 
 from __future__ import annotations

@@ -1,10 +1,12 @@
 """Benchmark: the reference scene (uncoated rigid-plastic, r = 200 um, 3 N) at several particle sizes.
 
-    python benchmarks/mpm_reference.py --sizes-um 10 5 --threads 2
+    python benchmarks/mpm_reference.py --sizes-um 10 5 --sized-domain [--threads 2] [--scene FILE] [--out FILE]
 
-Writes benchmarks/results/mpm_reference.json and prints a Markdown table (wall time, steps,
-particles, particle-steps per second, and the physics: mu, mu_pl, mu_sh, dp, penetration,
-against the analytical model).
+Writes ``--out`` (default benchmarks/results/mpm_reference[_<scene>]_sized.json, or ``_paper_block``
+without ``--sized-domain``; ``_<scene>`` only for a scene other than the reference one) and prints a
+Markdown table (wall time, steps, particles, particle-steps per second, and the physics: mu, mu_pl,
+mu_sh, dp, penetration, against the analytical model). benchmarks/results/mpm_reference_sized.json
+is the throughput the reproduction projection reads (benchmarks/reproduction_time.py).
 """
 
 from __future__ import annotations
@@ -32,8 +34,14 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--k1", type=float, default=125.0, help="analytical model's k1 (coated scenes)")
     parser.add_argument("--sized-domain", action="store_true", help="size the block from the expected contact")
-    parser.add_argument("--out", default=str(ROOT / "benchmarks" / "results" / "mpm_reference.json"))
+    parser.add_argument("--out", default=None,
+                        help="results file (default benchmarks/results/mpm_reference[_<scene>]_<block>.json)")
     args = parser.parse_args()
+    if args.out is None:  # named for what it measures, so that another scene or block never overwrites the reference
+        default_scene = Path(args.scene).resolve() == (ROOT / "examples" / "uncoated_rigid_plastic.yaml").resolve()
+        scene_part = "" if default_scene else f"_{Scene.from_yaml(Path(args.scene)).name}"
+        block_part = "_sized" if args.sized_domain else "_paper_block"
+        args.out = str(ROOT / "benchmarks" / "results" / f"mpm_reference{scene_part}{block_part}.json")
     numba.set_num_threads(args.threads)
     base = Scene.from_yaml(Path(args.scene))
     Hs = 3.0 * base.layers.substrate.flow.sigma_y_Pa

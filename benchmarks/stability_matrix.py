@@ -1,7 +1,7 @@
 """Stability stress matrix (issue 5): extreme numerical settings and scenes on a small
 rigid-plastic scene (r = 0.2 mm, 1 N, h = 10 um, 0.2 mm slide, sized block).
 
-    python benchmarks/stability_matrix.py [--active-zone 4 --out benchmarks/results/stability_matrix_active_zone4.json]
+    python benchmarks/stability_matrix.py [--active-zone 4 --out FILE]
 
 Each case either completes — then mu, Fz/load, the deepest particle penetration into the sphere
 (in units of h) and the energy ratio (sum of the energy terms / external work) are reported — or
