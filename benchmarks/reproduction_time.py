@@ -18,8 +18,8 @@ worked on per second over the same scenes' runs without a zone (median over
 docs/journal/2026-11-23-active-zone/active_zone.json, zone as configured).
 Runs whose layers use the real materials' flow laws (hardening, rate terms, heating: Figs. 14-23)
 go at the real-materials' share of the constant-flow throughput measured on the same block
-(benchmarks/results/material_cost.json, ``benchmarks/material_cost.py``); the rigid-plastic runs
-at the reference throughput.
+(docs/journal/2026-11-23-flow-law-cost/material_cost.json, measured by the retired
+``benchmarks/material_cost.py``); the rigid-plastic runs at the reference throughput.
 With ``--calibration FILE ...`` (``benchmarks/projection_check.py`` results: workflow runs that were made,
 their job wall times beside the projection) the projection is also scaled per family (rigid-plastic, real
 materials) by measured / projected over that family's measured runs at the particle size nearest in
@@ -84,7 +84,8 @@ def add_measured_arguments(parser: argparse.ArgumentParser) -> None:
                                                          / "graded_particles.json"))
     parser.add_argument("--zone-measured", default=str(ROOT / "docs" / "journal" / "2026-11-23-active-zone"
                                                        / "active_zone.json"))
-    parser.add_argument("--material-measured", default=str(ROOT / "benchmarks" / "results" / "material_cost.json"))
+    parser.add_argument("--material-measured", default=str(ROOT / "docs" / "journal" / "2026-11-23-flow-law-cost"
+                                                           / "material_cost.json"))
 
 
 def throughput_model(config: dict, args: argparse.Namespace) -> tuple[float, float, float, float]:

@@ -378,7 +378,7 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
     (``G2P_BLOCK`` in the solver), not on one contiguous slab: the particles that flow, whose return
     map costs several flow-law evaluations, lie around the sphere, and a slab split gave one thread
     most of them (zinc-coated steel at h = 10 um, start of the slide: 29.3 against 12.1 ms for the two
-    halves on one thread, benchmarks/g2p_balance.py). ``block`` = ceil(n / n_chunks) gives one
+    halves on one thread, docs/journal/2026-11-23-g2p-load-balance.md). ``block`` = ceil(n / n_chunks) gives one
     contiguous slab per chunk (the earlier split, whose slab ends could lie one particle off).
     """
     n_chunks = acc.shape[0]
