@@ -11,6 +11,7 @@ from __future__ import annotations
 import dataclasses
 import math
 import re
+import textwrap
 from pathlib import Path
 from typing import Any
 
@@ -260,3 +261,17 @@ def test_every_named_material_and_result_variable_is_on_the_page():
     variables = [*io.SERIES_META, *io.STEADY_META, *io.STANDARD_ERROR_META, *io.STEADINESS_META]
     absent = [v for v in variables if f"`{v}`" not in text]
     assert not absent, f"docs/scenes.md: result variables not described: {absent}"
+
+
+def yaml_blocks() -> list[str]:
+    return re.findall(r"```yaml\n(.*?)```", DOC.read_text(encoding="utf-8"), flags=re.S)
+
+
+def test_the_pages_yaml_examples_read():
+    """The scene at the top is examples/coated_rigid_plastic.yaml; the full material mapping is bulk zinc."""
+    scene, material = yaml_blocks()
+    example = Path(__file__).resolve().parents[2] / "examples" / "coated_rigid_plastic.yaml"
+    assert Scene.from_yaml(scene) == Scene.from_yaml(example)
+    spec = yaml.safe_load(textwrap.dedent(material))["substrate"]
+    read = material_from_spec(spec, coating=False, where="layers.substrate")
+    assert close(dataclasses.asdict(read) | {"name": ""}, dataclasses.asdict(MATERIALS["zinc_bulk"]) | {"name": ""})
