@@ -483,7 +483,8 @@ def test_wave_limit_is_cos_squared_of_the_leading_edge_angle_of_the_expected_con
 
 def test_interface_strength_ratio_says_when_the_contact_can_stick():
     """tau / kappa of the top layer; at or above the wave limit on a perfectly plastic layer it is flagged in
-    the output, because mu then follows the simulated speed (README, Interface shear)."""
+    the output, because mu then follows the simulated speed
+    (docs/journal/2026-11-24-inertia-ladder-and-wave-limit.md)."""
     f1 = Scene.from_dict(example_dict())  # uncoated 900 MPa, proportional f = 1
     assert f1.interface_strength_ratio == 1.0 and f1.interface_sticks
     assert "prow" in io.interface_regime(f1) and "cos^2 alpha = 0.947" in io.interface_regime(f1)

@@ -142,10 +142,11 @@ def _coated_at(h_um: float, f: float, mass_scaling_factor: float = 1.0) -> Scene
 def test_inertia_moves_mu_less_than_the_discretisation_where_a_steady_state_exists():
     """Issue 3's inertia check at a size CI affords, below the wave limit (f = 0, the ploughing alone): on the
     coated scene at h = 10 um, mass scaling / 4 (the same numbers as speed / 2) moves mu by a small fraction
-    of what halving h from 20 to 10 um does. Measured 2026-11-24 (README, *Interface shear*): mu 0.1429 ->
-    0.1438 (+0.6%) with mass scaling / 4, against 0.2194 at h = 20 um (+54%). (dp, about one particle deep
-    at h = 10 um, is too noisy for a check at this size: 5.8 -> 12.1 um.) At f = 1, above the wave limit,
-    mu has no limit to settle to (the ladder in the README), which is why the check is made here."""
+    of what halving h from 20 to 10 um does. Measured 2026-11-24
+    (docs/journal/2026-11-24-inertia-check-below-the-wave-limit.md): mu 0.1429 -> 0.1438 (+0.6%) with mass
+    scaling / 4, against 0.2194 at h = 20 um (+54%). (dp, about one particle deep at h = 10 um, is too noisy
+    for a check at this size: 5.8 -> 12.1 um.) At f = 1, above the wave limit, mu has no limit to settle to
+    (docs/journal/2026-11-24-inertia-ladder-and-wave-limit.md), which is why the check is made here."""
     scene = _coated_at(10.0, 0.0)
     assert not scene.interface_sticks
     mu = float(simulate(scene, progress=False)["mu"])

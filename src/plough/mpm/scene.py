@@ -560,8 +560,8 @@ class Scene:
     def grid_headroom_m(self) -> float:
         """Height of the grid above the original surface: ``domain.headroom_m``, or room for the
         pile-up of the expected groove, max(2 dp, 2 cells) + 0.5 dp (the grid adds 2-3 cells of
-        padding). A prow that keeps growing (f = 1 at h = 2.5 um, README *Status*; a soft coating
-        the sphere sweeps ahead) outgrows any fixed rule, and one expected contact radius more would
+        padding). A prow that keeps growing (f = 1 at h = 2.5 um, docs/journal/2026-11-22-prow-at-h2.5.md; a soft
+        coating the sphere sweeps ahead) outgrows any fixed rule, and one expected contact radius more would
         cost 9-22% more grid nodes at h <= 5 um on the reference scenes: with this automatic value
         the solver raises the grid's top mid-run where material reaches it
         (``solver.raise_grid_top``), lengthens the grid past the block's far end
@@ -665,9 +665,10 @@ class Scene:
 
         The contact then sticks and drags the layer just below the surface along, a wedge of it builds
         up ahead of the sphere, and mu follows the simulated speed and mass scaling without settling
-        (README, *Interface shear*). Measured on the coated rigid-plastic scene at h = 20 um, down to
-        1/256 of the paper's inertia: mu settles at f = 0.5, 0.7 and 0.8 and wanders by +-6 to 9% at
-        f = 0.9, 0.95 and 1, where ``wave_limit_ratio`` is 0.894; at h = 10 and 5 um the f = 1 runs rise
+        (docs/journal/2026-11-22-interface-entrainment.md). Measured on the coated rigid-plastic scene at
+        h = 20 um, down to 1/256 of the paper's inertia: mu settles at f = 0.5, 0.7 and 0.8 and wanders by +-6
+        to 9% at f = 0.9, 0.95 and 1, where ``wave_limit_ratio`` is 0.894
+        (docs/journal/2026-11-24-inertia-ladder-and-wave-limit.md); at h = 10 and 5 um the f = 1 runs rise
         with the simulated time (f = 0.5 settles). A hardening layer is not flagged: its strength grows
         under the sphere (not measured).
         """

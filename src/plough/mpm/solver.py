@@ -66,19 +66,21 @@ INTEGRAL_STEPS = 100.0
 ZONE_PAD_CELLS = 4
 #: the automatic headroom is raised mid-run up to this many sphere radii above the original surface
 #: (the sphere's top): a soft coating the sphere sweeps ahead can stack far above the expected
-#: pile-up (H~ = 0.1 at h = 10 um: 197 um after 600 um of sliding, README *Status*), but material
-#: above the sphere is flung, not ploughed
+#: pile-up (H~ = 0.1 at h = 10 um: 197 um after 600 um of sliding, docs/journal/2026-11-23-preview-run.md), but
+#: material above the sphere is flung, not ploughed
 GRID_TOP_LIMIT_RADII = 2.0
 #: with the automatic headroom the grid also lengthens past the block's far end, up to this many sphere
 #: radii: a soft coating's chip sheds fragments the 1e6 mass scaling flings ahead of the sphere (H~ = 0.25 at
-#: h = 5 um: up to 377 um ahead, at 4.5x the slide speed, README *Status*); they stay in the run
+#: h = 5 um: up to 377 um ahead, at 4.5x the slide speed, docs/journal/2026-11-23-soft-coating-fragments.md);
+#: they stay in the run
 GRID_END_LIMIT_RADII = 2.0
 #: each lengthening (and widening) adds room for the farthest particle plus this many sphere radii, so that
 #: fragments flying on do not reallocate the grid every few steps
 GRID_END_STEP_RADII = 0.25
 #: with the automatic headroom the grid also widens past the block's side face y = R (the high side; with
 #: the mirror plane the only one), up to this many sphere radii: the f = 0.5 coated run at h = 2.5 um threw a
-#: coating particle out through it, 13 um above the surface, 567.5 um into a 600 um slide (README *Status*)
+#: coating particle out through it, 13 um above the surface, 567.5 um into a 600 um slide
+#: (docs/journal/2026-11-24-coated-f0.5-h2.5-growing-grid.md)
 GRID_SIDE_LIMIT_RADII = 2.0
 
 

@@ -16,7 +16,7 @@ skipping that run is refused by the dataset builder.
 Default off (``null``): the faithful reproduction runs every size.
 
 **Failure markers.** A finest sweep run may also stop unstable (``plough.mpm.solver.InstabilityError``:
-at h = 2.5 um a prow can grow until material leaves the grid, README *Status*). With
+at h = 2.5 um a prow can grow until material leaves the grid, docs/journal/2026-11-22-prow-at-h2.5.md). With
 ``mpm.finest_failure: record`` (the default) its result file is then a *failure marker* (no result
 variables; the solver's message, the run id and provenance as attributes) and the figure dataset
 extrapolates that point from the two coarser sizes, as for a skipped run, flagged ``failed_finest``.
