@@ -1,6 +1,7 @@
 """Command line: ``plough analytical ...`` and ``plough mpm SCENE.yaml ...``.
 
-Bad input gives a one-line message naming the parameter and exit code 2, never a traceback.
+Bad input gives a one-line message naming the parameter and exit code 2, never a traceback; Ctrl-C gives one
+line and exit code 130, and leaves no partial file (results and snapshots are written atomically).
 """
 
 from __future__ import annotations
@@ -8,8 +9,9 @@ from __future__ import annotations
 import argparse
 import re
 import sys
+import warnings
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TextIO
 
 from plough import __version__
 
@@ -164,15 +166,44 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+#: exit status after Ctrl-C, as a shell reports a process ended by SIGINT (128 + 2)
+EXIT_INTERRUPTED = 130
+
+
+def _interrupted(args: argparse.Namespace) -> str:
+    """What Ctrl-C left: the result is written atomically (and snapshots too), so no partial file."""
+    if args.command != "mpm":
+        return "interrupted (Ctrl-C)"
+    kept = f"; the complete snapshots so far stay in {args.snapshots}" if args.snapshots else ""
+    return f"interrupted (Ctrl-C); no result written, no partial file left{kept}"
+
+
+def _show_warning(message: Warning | str, category: type[Warning], filename: str, lineno: int,
+                  file: TextIO | None = None, line: str | None = None) -> None:
+    """plough's own warnings (an unsteady window, an under-resolved contact) as one line each; others as usual."""
+    if getattr(category, "__module__", "").startswith("plough."):
+        print(f"plough: warning: {message}", file=sys.stderr)
+    else:
+        _default_show_warning(message, category, filename, lineno, file, line)
+
+
+_default_show_warning = warnings.showwarning
+
+
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     func: Callable[[argparse.Namespace], int] = args.func
     try:
-        return func(args)
-    # RuntimeError: an unstable MPM run; OSError: a file that cannot be read or written
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return func(args)
+    # RuntimeError: an unstable MPM run; OSError: a file that cannot be read or written (a full disk says so)
     except (ValueError, OSError, RuntimeError) as exc:
         print(f"plough {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print(f"plough {args.command}: {_interrupted(args)}", file=sys.stderr)
+        return EXIT_INTERRUPTED
 
 
 if __name__ == "__main__":  # pragma: no cover

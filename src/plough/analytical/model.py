@@ -4,6 +4,7 @@ Equations (the paper's numbers):
 
 - (1)       effective hardness  Hcs = Hc + (Hs - Hc) exp(-k1 t / r)
 - (2.1-2.3) contact in the coating only: Axy = Fn / Hcs, dp = r - sqrt(r^2 - a^2), Ayz = seg(r, a, r - dp)
+            (evaluated as dp = a^2 / (r + sqrt(r^2 - a^2)): finite and accurate for any finite input)
 - (3.1-3.5) contact reaching the substrate (dp > t): Axyc, the quadratic for ds, Axys, Ayzs, Ayzc
 - (4.1-4.4) mu = mu_pl + mu_sh, mu_pl = (Hs Ayzs + Hc Ayzc) / Fn, mu_sh = (tau_s Axys + tau_c Axyc) / Fn
 - (5.1-5.2) normal-load correction Fn' = Fn + Fz_sh, Fz_sh = tau_s Ayzs + tau_c Ayzc
@@ -97,12 +98,54 @@ class PloughingResult:
 
 
 # ----------------------------------------------------------------------------- geometry
-def segment_area(r: np.ndarray, a: np.ndarray, h: np.ndarray) -> np.ndarray:
-    """Area of the circular segment of half-chord a whose chord lies at distance h from the centre.
+#: below this angle x = 2 theta, (x - sin x) / x^3 is summed as its series (cancellation-free); above it,
+#: x - sin x loses at most eps / (x^2 / 6) ~ 5e-15 relative
+_SERIES_BELOW = 0.5
+#: (-1)^k / (2k + 3)! for k = 0..7: (x - sin x) / x^3 = sum_k c_k x^(2k); the next term is below 1e-20 at x = 0.5
+_SINE_REST = tuple((-1) ** k / float(np.prod(np.arange(1, 2 * k + 4))) for k in range(8))
 
-    seg(r, a, h) = r^2 atan(a / h) - a h   (arctan2 keeps h = 0, the half disc, exact).
+
+def _sine_rest(x: np.ndarray) -> np.ndarray:
+    """(x - sin x) / x^2 for x in [0, pi], without the cancellation of x - sin x at small x."""
+    x = np.asarray(x, dtype=float)
+    x2 = x * x
+    series = np.zeros_like(x)
+    for c in reversed(_SINE_REST):
+        series = series * x2 + c
+    with np.errstate(invalid="ignore", divide="ignore"):
+        direct = (x - np.sin(x)) / x2
+    return np.where(x < _SERIES_BELOW, x * series, direct)
+
+
+def segment_area(r: np.ndarray, a: np.ndarray, h: np.ndarray) -> np.ndarray:
+    """Area of the circular segment of half-chord a whose chord lies at distance h >= 0 from the centre
+    (a chord of the circle: a^2 + h^2 = r^2).
+
+    seg(r, a, h) = r^2 theta - a h with theta = atan(a / h), written as 2 (r theta)^2 (x - sin x) / x^2,
+    x = 2 theta: no cancellation for a small segment (a / r = 1e-9 keeps its (2/3) a^3 / r) and no overflow
+    of r^2 (r = 1e300 m). arctan2 keeps h = 0, the half disc, exact.
     """
-    return r * r * np.arctan2(a, h) - a * h
+    r, a, h = (np.asarray(v, dtype=float) for v in (r, a, h))
+    theta = np.arctan2(a, h)
+    r_theta = r * theta
+    return 2.0 * r_theta * r_theta * _sine_rest(2.0 * theta)
+
+
+def _sagitta(a: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Eq. 2.2 in its cancellation-free form: dp = r - sqrt(r^2 - a^2) = a^2 / (r + sqrt(r^2 - a^2)).
+
+    Written with s = a / r as a s / (1 + sqrt((1 - s)(1 + s))): r^2 never formed (no overflow at r = 1e300 m),
+    and no cancellation at a / r = 1e-9 (where r - sqrt(r^2 - a^2) is 0). NaN-free for a > r (the caller
+    refuses that contact).
+    """
+    s = a / r
+    return a * s / (1.0 + np.sqrt(np.maximum((1.0 - s) * (1.0 + s), 0.0)))
+
+
+def _half_chord(d: np.ndarray, r: np.ndarray) -> np.ndarray:
+    """Contact radius of a cap of depth d <= r: sqrt(r^2 - (r - d)^2) = sqrt(d (2 r - d)), without cancellation
+    (a small depth) or overflow (a huge radius)."""
+    return np.sqrt(d) * np.sqrt(r) * np.sqrt(np.maximum(2.0 - d / r, 0.0))
 
 
 def effective_hardness(
@@ -115,35 +158,37 @@ def effective_hardness(
 def _contact_geometry(load: np.ndarray, r: np.ndarray, t: np.ndarray, Hcs: np.ndarray,
                       Hs: np.ndarray) -> dict[str, np.ndarray]:
     """Eqs. 2.1-3.5 for a given load carried by the contact; returns areas and depths."""
-    with np.errstate(invalid="ignore", divide="ignore"):
+    with np.errstate(invalid="ignore", divide="ignore", under="ignore", over="ignore"):  # the other case's branch
         # Case 1 (eqs. 2.1-2.3): the coating alone carries the load at hardness Hcs.
         Axy1 = load / Hcs
         a1 = np.sqrt(2.0 * Axy1 / np.pi)
-        dp1 = r - np.sqrt(np.maximum(r * r - a1 * a1, 0.0))
+        dp1 = _sagitta(a1, r)
         too_wide1 = a1 > r
 
-        # Case 2 (eqs. 3.1-3.5): quadratic for the depth ds into the substrate.
-        A = 0.5 * np.pi * Hs
-        B = np.pi * (Hcs * t - Hs * r)
-        C = load - 0.5 * np.pi * t * (2.0 * r - t) * Hcs
-        disc = B * B - 4.0 * A * C
-        # Stable form of the smaller root (-B - sqrt(disc)) / 2A: B < 0 whenever a root with
-        # ds < r exists, so -B + sqrt(disc) has no cancellation; C = 0 gives ds = 0 exactly.
-        ds2 = 2.0 * C / (-B + np.sqrt(np.maximum(disc, 0.0)))
-        ds2 = np.maximum(ds2, 0.0)
+        # Case 2 (eqs. 3.1-3.5): the quadratic A ds^2 + B ds + C = 0 with A = pi Hs / 2, B = pi (Hcs t - Hs r),
+        # C = Fn - pi t (2 r - t) Hcs / 2, divided by pi Hs r (Hs r^2 would overflow at a huge radius, and
+        # Fn / (Hs r^2) underflow): ds^2 / (2 r) - b ds + g = 0 with b = 1 - (Hcs / Hs)(t / r) and the length
+        # g = Fn / (pi Hs r) - t (2 - t / r)(Hcs / Hs) / 2. The smaller root in the stable form
+        # ds = 2 g / (b + sqrt(b^2 - 2 g / r)): b > 0 whenever a root with ds < r exists, so nothing cancels
+        # (uncoated, t = 0: the form of eq. 2.2), and g = 0 gives ds = 0 exactly.
+        tau, eta = t / r, Hcs / Hs
+        b = 1.0 - eta * tau
+        g = load / Hs / r / np.pi - 0.5 * t * (2.0 - tau) * eta
+        disc = b * b - 2.0 * g / r
+        ds2 = np.maximum(2.0 * g / (b + np.sqrt(np.maximum(disc, 0.0))), 0.0)
         dp2 = ds2 + t
         case2 = dp1 > t
-        too_wide2 = case2 & ((disc < 0.0) | (B >= 0.0) | (dp2 > r))
+        too_wide2 = case2 & ((disc < 0.0) | (b <= 0.0) | (dp2 > r))
 
         dp = np.where(case2, dp2, dp1)
         ds = np.where(case2, ds2, 0.0)
-        a = np.sqrt(np.maximum(r * r - (r - dp) ** 2, 0.0))
-        a_s = np.sqrt(np.maximum(r * r - (r - ds) ** 2, 0.0))
+        a = np.where(case2, _half_chord(dp, r), a1)
+        a_s = _half_chord(ds, r)
         Axy = 0.5 * np.pi * a * a
         Ayz = segment_area(r, a, r - dp)
         Axys = np.where(case2, 0.5 * np.pi * a_s * a_s, 0.0)
         Ayzs = np.where(case2, segment_area(r, a_s, r - ds), 0.0)
-        Axyc = np.where(case2, 0.5 * np.pi * t * (2.0 * (r - ds) - t), Axy)
+        Axyc = np.where(case2, np.pi * t * ((r - ds) - 0.5 * t), Axy)  # pi t (2 (r - ds) - t) / 2, no 2 r
         Ayzc = Ayz - Ayzs
     return {
         "dp": dp, "ds": ds, "a": a, "a_s": a_s, "Axy": Axy, "Ayz": Ayz, "Axys": Axys,
@@ -201,6 +246,18 @@ def _validate(load, r, t, Hc, Hs, k1, interface, f, H0, Cp, np_, correction) -> 
         if np.any(bad):
             v = np.asarray(np_)[bad].flat[0] if np.ndim(np_) else np_
             raise ValueError(f"np = {float(v):g} is outside the allowed range [0, 1]")
+
+
+def _check_representable(values: dict[str, np.ndarray], load: np.ndarray, r: np.ndarray) -> None:
+    """Refuse inputs whose results leave double precision (an area of 1e600 m2), naming them, rather than
+    print inf or nan."""
+    for name, value in values.items():
+        bad = ~np.isfinite(value)
+        if np.any(bad):
+            i = np.flatnonzero(np.ravel(np.broadcast_to(bad, load.shape)))[0]
+            raise ValueError(f"load_N = {float(np.ravel(load)[i]):g} N with radius_m = {float(np.ravel(r)[i]):g} m "
+                             f"gives {name} = {float(np.ravel(np.broadcast_to(value, load.shape))[i]):g}, beyond "
+                             "double precision (allowed: inputs whose contact areas and forces are finite numbers)")
 
 
 # ----------------------------------------------------------------------------- entry point
@@ -276,6 +333,8 @@ def ploughing(
     Fz_sh = tau_s * geo["Ayzs"] + tau_c * geo["Ayzc"]
     mu_pl = (Hs * geo["Ayzs"] + Hc * geo["Ayzc"]) / load
     mu_sh = (tau_s * geo["Axys"] + tau_c * geo["Axyc"]) / load
+    _check_representable({"Axy": geo["Axy"], "Ayz": geo["Ayz"], "Fz_sh": Fz_sh, "mu_pl": mu_pl, "mu_sh": mu_sh},
+                         load, r)
     return PloughingResult(
         Hcs=Hcs, load_carried=np.asarray(carried, dtype=float), dp=geo["dp"], ds=geo["ds"],
         a=geo["a"], a_s=geo["a_s"], Axy=geo["Axy"], Axys=geo["Axys"], Axyc=geo["Axyc"],
