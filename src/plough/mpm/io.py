@@ -17,7 +17,10 @@ Snapshots are VTK XML PolyData (.vtp) files, which ParaView and OVITO open.
 from __future__ import annotations
 
 import base64
+import errno
 import json
+import os
+import shutil
 import warnings
 from collections.abc import Callable
 from pathlib import Path
@@ -25,7 +28,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from plough.io import provenance_attrs, write_netcdf_atomic
+from plough.io import provenance_attrs, temporary_beside, write_netcdf_atomic
 from plough.mpm.particles import Particles
 from plough.mpm.scene import Scene
 
@@ -437,8 +440,52 @@ def interface_regime(scene: Scene) -> str:
             f"limit cos^2 alpha = {limit:.3g} of the expected contact)")
 
 
+class DiskFullError(OSError):
+    """No space left on the device a result or a snapshot goes to (errno ENOSPC), said with the file's name.
+
+    netCDF reports a full disk as "NetCDF: HDF error", and only when the whole run is done: the writers here
+    tell it by the free space left (``shutil.disk_usage``) against the bytes the file needs.
+    """
+
+    def __init__(self, path: Path, need: int, free: int | None, cause: str = "") -> None:
+        super().__init__(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        room = "" if free is None else f", {_megabytes(free)} free there"
+        said = f" ({cause})" if cause else ""
+        self.message = (f"no space left on device for {path}{said}: it needs about {_megabytes(need)}{room}; free "
+                        "some space (or write elsewhere) and run again; nothing was written under that name")
+
+    def __str__(self) -> str:
+        return self.message
+
+
+def _megabytes(n: int) -> str:
+    return f"{n / 1e6:.3g} MB"
+
+
+def _free_bytes(folder: Path) -> int | None:
+    try:
+        return shutil.disk_usage(folder).free
+    except OSError:
+        return None
+
+
 def write_result(ds: xr.Dataset, path: str | Path) -> Path:
-    return write_netcdf_atomic(ds, path)
+    """Write a run's dataset atomically (``plough.io.write_netcdf_atomic``); a full disk is refused before
+    writing when the free space is already short of the data, and named as such (with the path) when the
+    writer fails on it. Any other failure names the path too."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    need = int(ds.nbytes)
+    free = _free_bytes(path.parent)
+    if free is not None and free < need:
+        raise DiskFullError(path, need, free, "refused before writing")
+    try:
+        return write_netcdf_atomic(ds, path)
+    except (OSError, RuntimeError) as exc:  # netCDF4: RuntimeError("NetCDF: HDF error") from a full disk
+        free = _free_bytes(path.parent)  # the temporary file is gone again: what is left is what there was
+        if getattr(exc, "errno", None) == errno.ENOSPC or (free is not None and free < need):
+            raise DiskFullError(path, need, free, str(exc)) from exc
+        raise OSError(f"{path} could not be written: {exc}") from exc
 
 
 # ----------------------------------------------------------------------------- snapshots
@@ -452,7 +499,10 @@ def _data_array(name: str, arr: np.ndarray, ncomp: int) -> str:
 
 def write_snapshot(p: Particles, path: str | Path, sphere_centre: np.ndarray, sphere_radius: float,
                    coating_row: int = -1) -> Path:
-    """Particles as VTK XML PolyData (.vtp): position, material, plastic strain, temperature, stress, size."""
+    """Particles as VTK XML PolyData (.vtp): position, material, plastic strain, temperature, stress, size.
+
+    Written atomically (a temporary name, then a rename); a full disk raises ``DiskFullError`` naming the file.
+    """
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     n = p.n
@@ -492,5 +542,19 @@ def write_snapshot(p: Particles, path: str | Path, sphere_centre: np.ndarray, sp
         f"<!-- sphere centre {sphere_centre.tolist()} m, radius {sphere_radius} m -->",
         "</VTKFile>",
     ]
-    path.write_text("\n".join(xml))
+    text = "\n".join(xml)
+    # under a temporary name, renamed when complete: a full disk or Ctrl-C never leaves a truncated .vtp
+    tmp = None
+    try:
+        tmp = temporary_beside(path)
+        tmp.write_text(text)
+        os.replace(tmp, path)
+    except BaseException as exc:
+        if tmp is not None:
+            tmp.unlink(missing_ok=True)
+        if isinstance(exc, OSError) and exc.errno == errno.ENOSPC:
+            raise DiskFullError(path, len(text), _free_bytes(path.parent), "a snapshot") from None
+        if isinstance(exc, OSError):
+            raise OSError(f"snapshot {path} could not be written: {exc.strerror or exc}") from exc
+        raise
     return path
