@@ -33,7 +33,7 @@ def example_dict(name="uncoated_rigid_plastic"):
 # ----------------------------------------------------------------------------- round trips
 def test_the_examples_are_found():
     assert {p.stem for p in EXAMPLES} == {"coated_rigid_plastic", "uncoated_rigid_plastic", "zinc_coated_steel",
-                                          "stability_small"}
+                                          "stability_small", "quickstart"}
 
 
 @pytest.mark.parametrize("path", EXAMPLES, ids=lambda p: p.stem)
