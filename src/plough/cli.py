@@ -11,7 +11,7 @@ import re
 import sys
 import warnings
 from collections.abc import Callable, Sequence
-from typing import TYPE_CHECKING, TextIO
+from typing import TYPE_CHECKING, Any, TextIO
 
 from plough import __version__
 
@@ -143,8 +143,17 @@ def _run_mpm(args: argparse.Namespace) -> int:
     except ImportError as exc:  # pragma: no cover - until the solver lands
         raise ValueError(f"the MPM solver is not available in this build: {exc}") from None
     run_scene_file(args.scene, args.output, snapshots_dir=args.snapshots, threads=args.threads,
-                   progress=not args.quiet, preset=args.preset, on_scene=_note_interface)
+                   progress=not args.quiet, preset=args.preset, on_scene=_note_interface, on_defaults=_note_defaults)
     return 0
+
+
+def _note_defaults(defaults: dict[str, Any]) -> None:
+    """Say which keys the scene file left out and the defaults the run takes for them (also recorded in the
+    result as ``scene_defaults``)."""
+    from plough.mpm.scene import describe_defaults
+
+    print(f"plough: note: keys not in the scene file take their defaults (docs/scenes.md): "
+          f"{describe_defaults(defaults)}", file=sys.stderr)
 
 
 def _note_interface(scene: Scene) -> None:

@@ -30,7 +30,7 @@ import xarray as xr
 
 from plough.io import provenance_attrs, temporary_beside, write_netcdf_atomic
 from plough.mpm.particles import Particles
-from plough.mpm.scene import Scene
+from plough.mpm.scene import RESOLVED_CONTACT_PARTICLES, Scene
 
 SERIES_META = {
     "Fx": ("N", "friction force on the sphere (resisting the sliding, positive)"),
@@ -397,6 +397,13 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     ds.attrs["stopped_when_steady"] = int(slid_total < scene.sliding.distance_m)
     ds.attrs["coating_representation"] = coating_representation(scene)
     ds.attrs["interface_regime"] = interface_regime(scene)
+    ds.attrs["contact_radius_particles"] = float(scene.contact_resolution)
+    ds.attrs["resolution"] = scene.resolution_text()
+    if int(ds["steady"]) and scene.contact_resolution < RESOLVED_CONTACT_PARTICLES:
+        # steady says the window's mu and prow settled in time; an under-resolved contact does not undo that,
+        # but a steady flag must not read as a trustworthy number without saying so
+        ds["steady"].attrs["comment"] = ("steady in time only: the contact is under-resolved (attribute "
+                                         "resolution); the window settled on the discretisation's answer")
     return ds
 
 

@@ -12,14 +12,16 @@ import time
 import warnings
 from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numba
 import numpy as np
 import xarray as xr
 
+from plough.io import to_json
 from plough.mpm import contact, io, solver, transfers
 from plough.mpm.constitutive import pack_materials
-from plough.mpm.scene import PRESETS, Scene
+from plough.mpm.scene import PRESETS, RESOLVED_CONTACT_PARTICLES, Scene, defaults_taken, read_scene_data
 
 
 class _Recorder:
@@ -113,6 +115,16 @@ class SteadyStateWarning(UserWarning):
     """The run's steady window does not hold a steady state (``io.steadiness``)."""
 
 
+class ResolutionWarning(UserWarning):
+    """The expected contact radius is under ``scene.RESOLVED_CONTACT_PARTICLES`` particle sizes."""
+
+
+def warn_if_under_resolved(scene: Scene) -> None:
+    """Warn (ResolutionWarning) before a run whose expected contact spans too few particles to resolve it."""
+    if scene.contact_resolution < RESOLVED_CONTACT_PARTICLES:
+        warnings.warn(f"scene {scene.name!r}: {scene.resolution_text()}", ResolutionWarning, stacklevel=3)
+
+
 def check_threads(threads: int) -> None:
     """Refuse a thread count numba cannot use, naming it (numba's own error names no parameter)."""
     most = numba.config.NUMBA_NUM_THREADS
@@ -127,6 +139,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     if threads is not None:
         check_threads(threads)
         numba.set_num_threads(threads)
+    warn_if_under_resolved(scene)
     wall0 = time.perf_counter()
     state, const = solver.init(scene)
     max_press_steps = int(10 * scene.sphere.radius_m / (const.press_speed * const.dt))
@@ -243,16 +256,24 @@ def apply_preset(scene: Scene, preset: str | None) -> Scene:
 
 def run_scene_file(scene_path: str | Path, output: str | Path, *, snapshots_dir: str | Path | None = None,
                    threads: int | None = None, progress: bool = True, preset: str | None = None,
-                   on_scene: Callable[[Scene], None] | None = None) -> Path:
+                   on_scene: Callable[[Scene], None] | None = None,
+                   on_defaults: Callable[[dict[str, Any]], None] | None = None) -> Path:
     """Read a scene YAML, apply the optional preset, simulate, write the netCDF atomically
-    (nothing is written on failure). ``on_scene`` sees the validated scene before the run."""
+    (nothing is written on failure). ``on_scene`` sees the validated scene before the run, ``on_defaults``
+    the keys the file left to their defaults (``scene.defaults_taken``), which the result records as the
+    attribute ``scene_defaults`` (JSON, ``{}`` for a file that gives every key)."""
     if threads is not None:
         check_threads(threads)
-    scene = apply_preset(Scene.from_yaml(Path(scene_path)), preset)
+    data = read_scene_data(Path(scene_path))
+    scene = apply_preset(Scene.from_dict(data), preset)
+    defaults = defaults_taken(data, scene)
     check_output_paths(output, snapshots_dir)
     if on_scene is not None:
         on_scene(scene)
+    if on_defaults is not None and defaults:
+        on_defaults(defaults)
     ds = simulate(scene, progress=progress, snapshots_dir=snapshots_dir, threads=threads)
+    ds.attrs["scene_defaults"] = to_json(defaults)
     return io.write_result(ds, output)
 
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import math
 import re
-from dataclasses import asdict, dataclass, field, fields, replace
+from dataclasses import MISSING, asdict, dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
 
@@ -379,6 +379,16 @@ class Discretisation:
         return self.particle_size_m * self.particles_per_cell
 
 
+#: Fewest particle sizes h across the expected contact radius a (``Scene.contact_resolution``) for a run to
+#: count as resolving its contact; below it the run warns (``plough.mpm.run.ResolutionWarning``) and its result
+#: says so (``resolution``). Why 2: the contact acts on grid nodes up to one cell (2 h at 2 particles per cell)
+#: outside the sphere, so below a = 2 h that error is as large as the contact itself; measured on the preview
+#: matrix at the default controller (benchmarks/results/load_control_h20.json against load_control_h10_subset.json,
+#: setting "1,100"), mu moved +40% from h = 20 to 10 um at a = 1.83 h, and by -20% to +10% at a = 2.3-3.3 h
+#: (-4% at 5.3 h); issue 31's scene at a = 0.95 h gave mu 0.557 against the analytical 0.136. Every run of
+#: config/config.yaml has a >= 2.06 h (its smoke and preview matrices, coarse on purpose, go down to 0.94 h).
+RESOLVED_CONTACT_PARTICLES = 2.0
+
 #: Highest initial temperature accepted, K: above the melting point of every metal of the materials
 #: data (zinc 693 K, steel about 1800 K) the flow laws mean nothing; the check catches typos (in degC
 #: or negative) rather than setting a physical bound per material.
@@ -572,6 +582,23 @@ class Scene:
         return max(2.0 * dp, 2.0 * self.discretisation.cell_size_m) + 0.5 * dp
 
     @property
+    def contact_resolution(self) -> float:
+        """The expected contact radius in particle sizes, a / h (``RESOLVED_CONTACT_PARTICLES``)."""
+        a, _ = self.expected_contact()
+        return a / self.discretisation.particle_size_m
+
+    def resolution_text(self) -> str:
+        """The contact's resolution in words, under-resolved or not (the run's ``resolution`` attribute)."""
+        a, _ = self.expected_contact()
+        h = self.discretisation.particle_size_m
+        text = f"expected contact radius a = {a * 1e6:.3g} um is {a / h:.3g} particle sizes (h = {h * 1e6:g} um)"
+        if a / h >= RESOLVED_CONTACT_PARTICLES:
+            return text
+        return (f"{text}: under-resolved, below the {RESOLVED_CONTACT_PARTICLES:g} that resolve it (the contact acts "
+                "on grid nodes up to a cell outside the sphere, an error as large as the contact): mu and dp say "
+                "more about h than about the model; refine discretisation.particle_size_m")
+
+    @property
     def active_zone_half_width_m(self) -> float | None:
         """Half-length of the active zone along x: ``active_zone_contact_radii`` expected contact
         radii, at least ACTIVE_ZONE_MIN_PARTICLES particle sizes; None without a zone."""
@@ -758,29 +785,7 @@ class Scene:
 
     @classmethod
     def from_yaml(cls, path_or_text: str | Path) -> Scene:
-        p = Path(path_or_text)
-        if isinstance(path_or_text, Path) or (isinstance(path_or_text, str) and "\n" not in path_or_text):
-            if not p.exists():
-                raise FileNotFoundError(f"scene file {str(p)!r} does not exist")
-            if p.is_dir():
-                raise ValueError(f"scene file {str(p)!r} is a directory, not a YAML file")
-            # bytes: the YAML reader detects UTF-8 / UTF-16 itself, whatever the locale
-            text: str | bytes = p.read_bytes()
-            source = str(p)
-        else:
-            text = str(path_or_text)
-            source = "scene text"
-        try:
-            # YAML 1.1: 5e-1 is text; the parts convert numbers by their field types
-            data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader)
-        except yaml.YAMLError as exc:
-            where = getattr(exc, "problem_mark", None)
-            at = f" at line {where.line + 1}, column {where.column + 1}" if where is not None else ""
-            problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-            raise ValueError(f"{source}: not valid YAML{at}: {problem}") from None
-        if not isinstance(data, dict):
-            raise ValueError("a scene file must hold a mapping of keys to values")
-        return cls.from_dict(data)
+        return cls.from_dict(read_scene_data(path_or_text))
 
     def with_sized_domain(self, radius_contact_radii: float = 2.5, end_margin_contact_radii: float = 3.0) -> Scene:
         """A copy whose block is sized from the expected contact radius (see :func:`sized_domain`)."""
@@ -804,6 +809,107 @@ class Scene:
     def with_(self, **changes: Any) -> Scene:
         """A copy with some top-level parts replaced (validated again)."""
         return replace(self, **changes)
+
+
+def read_scene_data(path_or_text: str | Path) -> dict[str, Any]:
+    """The mapping a scene file (or YAML text) holds, as written (``Scene.from_dict`` builds the scene)."""
+    p = Path(path_or_text)
+    if isinstance(path_or_text, Path) or (isinstance(path_or_text, str) and "\n" not in path_or_text):
+        if not p.exists():
+            raise FileNotFoundError(f"scene file {str(p)!r} does not exist")
+        if p.is_dir():
+            raise ValueError(f"scene file {str(p)!r} is a directory, not a YAML file")
+        # bytes: the YAML reader detects UTF-8 / UTF-16 itself, whatever the locale
+        text: str | bytes = p.read_bytes()
+        source = str(p)
+    else:
+        text = str(path_or_text)
+        source = "scene text"
+    try:
+        # YAML 1.1: 5e-1 is text; the parts convert numbers by their field types
+        data = yaml.load(text, Loader=_UniqueKeyLoader)  # noqa: S506 (a SafeLoader)
+    except yaml.YAMLError as exc:
+        where = getattr(exc, "problem_mark", None)
+        at = f" at line {where.line + 1}, column {where.column + 1}" if where is not None else ""
+        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
+        raise ValueError(f"{source}: not valid YAML{at}: {problem}") from None
+    if not isinstance(data, dict):
+        raise ValueError("a scene file must hold a mapping of keys to values")
+    return data
+
+
+def _default(cls: type, name: str) -> Any:
+    f = {f.name: f for f in fields(cls)}[name]
+    return f.default_factory() if f.default is MISSING else f.default  # type: ignore[misc]
+
+
+def _plain(value: Any) -> Any:
+    return list(value) if isinstance(value, tuple) else value
+
+
+def defaults_taken(data: dict[str, Any], scene: Scene) -> dict[str, Any]:
+    """The keys a scene file (``data``, as read) leaves out and the built-in default values the run takes for
+    them: dotted SI key -> value (``interface`` -> its dict when the whole interface is left out).
+
+    Decision (issue 31): a scene file may leave any key but ``layers`` out, and the dataclass defaults stay
+    the one source of truth (docs/scenes.md lists them, tested against the dataclasses); a run says which it
+    took (``plough mpm`` prints them, the result records them as ``scene_defaults``). A key a preset has set
+    to another value since is not a default and is not listed; ``layers`` has no defaults worth naming (the
+    substrate is required, a coating needs its thickness, no coating is uncoated).
+    """
+    out: dict[str, Any] = {}
+    if "load_N" not in data and scene.load_N == _default(Scene, "load_N"):
+        out["load_N"] = scene.load_N
+    out |= _part_defaults(data, "sphere", scene.sphere)
+    if "interface" not in data:
+        if scene.interface == _default(Scene, "interface"):
+            out["interface"] = interface_to_dict(scene.interface)
+    else:
+        given = _to_si(_mapping(data["interface"], "interface"), "interface")
+        for f in fields(scene.interface):
+            value = getattr(scene.interface, f.name)
+            if f.name not in given and value == f.default:
+                out[f"interface.{f.name}"] = value
+    for part in ("domain", "sliding", "discretisation", "outputs"):
+        out |= _part_defaults(data, part, getattr(scene, part))
+    if "name" not in data and scene.name == _default(Scene, "name"):
+        out["name"] = scene.name
+    return out
+
+
+def _part_defaults(data: dict[str, Any], part: str, obj: Any) -> dict[str, Any]:
+    """The fields of one part (``sphere``, ``domain``, ...) the file leaves out, at their default values."""
+    given = _to_si(_mapping(data.get(part), part), part)
+    return {f"{part}.{f.name}": _plain(getattr(obj, f.name)) for f in fields(obj)
+            if f.name not in given and _plain(getattr(obj, f.name)) == _plain(_default(type(obj), f.name))}
+
+
+#: unit shown after a value, by its key's suffix (longest first)
+_SHOWN_UNITS = (("_m_s", "m/s"), ("_Pa", "Pa"), ("_m", "m"), ("_N", "N"), ("_K", "K"))
+
+
+def _shown(value: Any) -> str:
+    if isinstance(value, bool) or value is None:
+        return {True: "true", False: "false", None: "null"}[value]
+    if isinstance(value, float | int):
+        return f"{value:g}"
+    if isinstance(value, list):
+        return "[" + ", ".join(_shown(v) for v in value) + "]"
+    return str(value)
+
+
+def describe_defaults(defaults: dict[str, Any]) -> str:
+    """``defaults_taken`` as one line: ``load_N = 3 N; sphere.radius_m = 0.0002 m; interface = proportional,
+    f = 1; ...``."""
+    items = []
+    for key, value in defaults.items():
+        if isinstance(value, dict):  # a whole interface
+            items.append(f"{key} = " + ", ".join([str(value.get("model"))] + [f"{k} = {_shown(v)}" for k, v in
+                                                                             value.items() if k != "model"]))
+            continue
+        unit = next((u for suffix, u in _SHOWN_UNITS if key.endswith(suffix)), "")
+        items.append(f"{key} = {_shown(value)}" + (f" {unit}" if unit and value is not None else ""))
+    return "; ".join(items)
 
 
 def expected_contact(layers: Layers, load_N: float, sphere_radius_m: float) -> tuple[float, float]:
