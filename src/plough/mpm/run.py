@@ -312,8 +312,9 @@ def warm_up(threads: int | None = None) -> float:
                   load_N=0.5, domain=Domain(radius_m=100e-6, length_m=400e-6),
                   sliding=Sliding(distance_m=150e-6), discretisation=Discretisation(particle_size_m=20e-6),
                   outputs=Outputs(records=20), name="warm_up")
-    with warnings.catch_warnings():  # the compile-only scene is too short to be steady: not the user's run
+    with warnings.catch_warnings():  # the compile-only scene is short and coarse: not the user's run
         warnings.simplefilter("ignore", SteadyStateWarning)
+        warnings.simplefilter("ignore", ResolutionWarning)
         simulate(scene, progress=False, threads=threads)
     _compile_freeze(pack_materials(scene.layers.materials))
     return time.perf_counter() - t0
