@@ -47,3 +47,20 @@ def test_active_fraction_follows_the_solver(monkeypatch):
     assert est.active_fraction == pytest.approx(ds.attrs["cost_active_fraction"], rel=0.05)
     assert est.particle_steps == pytest.approx(ds.attrs["cost_particle_steps"], rel=0.1)
     assert est.active_fraction < 0.8
+
+
+def test_cluster_request_rate_is_no_faster_than_the_measured_workflow_jobs():
+    """The rate behind a cluster time request is at most that of every workflow job measured here that ran
+    long enough for its start-up not to count (over 200 s, 2 threads), so the request's safety factor is
+    left for the scaling to more threads."""
+    import json
+    from pathlib import Path
+
+    from plough.study.cost import THROUGHPUT_PER_THREAD
+
+    results = Path(__file__).parents[2] / "benchmarks/results"
+    runs = [r for name in ("projection_check_preview.json", "projection_check_h5_h2.5.json")
+            for r in json.loads((results / name).read_text())["runs"] if r["measured_s"] > 200.0]
+    assert len(runs) >= 10
+    for r in runs:
+        assert r["particle_steps"] / (THROUGHPUT_PER_THREAD * 2) >= r["measured_s"], r["run"]

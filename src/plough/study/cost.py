@@ -82,9 +82,13 @@ def active_fraction(start_m: float, slide_m: float, length_m: float, half_width_
     return (steps_in_place * share(start_m) + steps_sliding * sliding) / (steps_in_place + steps_sliding)
 
 
-#: Particle-steps per second per thread measured on the reference scene
-#: (benchmarks/mpm_reference.py, 2 threads: ~4.6 M/s); used for cluster run-time requests.
-THROUGHPUT_PER_THREAD = 2.3e6
+#: Particle-steps per second per thread for cluster run-time requests: the slowest aggregate rate
+#: measured for workflow jobs, the preview's 70 rigid-plastic runs as Snakemake jobs on 2 threads
+#: (1.45 M/s; its 64 real-material runs 1.67 M/s; benchmarks/results/projection_check_preview.json).
+#: The reference scene's 4.6 M/s on 2 threads let a job's request fall short of its run. Scaling to
+#: more threads is taken as linear, which the request's safety factor has to cover; the fixed 5 min
+#: covers the start-up of small runs.
+THROUGHPUT_PER_THREAD = 0.72e6
 
 
 def runtime_minutes(cost: RunCost, threads: int, safety: float = 2.0) -> int:
