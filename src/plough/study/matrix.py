@@ -16,7 +16,10 @@ rigid-plastic studies, 3 sigma_y at a plastic strain of 0.08 (Tabor) for the rea
 
 from __future__ import annotations
 
+import math
+import re
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -57,6 +60,112 @@ def fmt(x: float) -> str:
     return f"{float(x):g}"
 
 
+# ----------------------------------------------------------------------------- the config's numbers
+#: the workflow's config schema (the Snakefile validates the config against it before anything else)
+CONFIG_SCHEMA = Path(__file__).resolve().parents[3] / "workflow" / "schemas" / "config.schema.yaml"
+#: text that reads as a number (the schema's ``number`` definition): YAML 1.1 reads 3e-1 as text
+_NUMBER_TEXT = re.compile(r"[-+]?([0-9]+[.]?[0-9]*|[.][0-9]+)([eE][-+]?[0-9]+)?")
+
+
+def _key_path(parts: Any) -> str:
+    """``mpm.numerics.cfl``, ``analytical.thickness_um[1]``: a key path as the messages name it."""
+    out = ""
+    for part in parts:
+        out += f"[{part}]" if isinstance(part, int) else (f".{part}" if out else str(part))
+    return out
+
+
+def _numbers_read(node: Any, path: tuple = ()) -> list[tuple[tuple, str]]:
+    """Convert, in place, text that reads as a number to the number; returns (path, text) of each."""
+    read = []
+    items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
+    for key, value in list(items):
+        if isinstance(value, str) and _NUMBER_TEXT.fullmatch(value.strip()):
+            node[key] = float(value)
+            read.append(((*path, key), value))
+        else:
+            read += _numbers_read(value, (*path, key))
+    return read
+
+
+def _not_finite(node: Any, path: tuple = ()) -> tuple[tuple, float] | None:
+    items = node.items() if isinstance(node, dict) else enumerate(node) if isinstance(node, list) else ()
+    for key, value in items:
+        if isinstance(value, float) and not math.isfinite(value):
+            return (*path, key), value
+        found = _not_finite(value, (*path, key))
+        if found is not None:
+            return found
+    return None
+
+
+def check_config(config: dict[str, Any], schema: Path = CONFIG_SCHEMA) -> None:
+    """The checks the schema cannot make, before any scene is built, each a one-line error naming the key path.
+
+    * Text that reads as a number (``cfl: 3e-1``: YAML 1.1, which Snakemake reads config files with, takes an
+      exponent without a dot for text; the schema lets it through as scene files do) becomes the number, in
+      place, and the config is validated against ``schema`` again so that its range is checked too.
+    * NaN and infinity are refused anywhere (a JSON schema's ranges let NaN through: every comparison with
+      NaN is false).
+
+    ``all_runs`` calls it first, so the workflow makes these checks when it builds its run matrix, before any job.
+    """
+    read = _numbers_read(config)
+    bad = _not_finite(config)
+    if bad is not None:
+        raise ValueError(f"config: {_key_path(bad[0])} = {bad[1]:g} is not a finite number")
+    if not read or not schema.exists():
+        return
+    import jsonschema
+    import yaml
+
+    validator = jsonschema.Draft202012Validator(yaml.safe_load(schema.read_text()))
+    error = jsonschema.exceptions.best_match(validator.iter_errors(config))
+    if error is not None:
+        where = _key_path(error.absolute_path)
+        given = dict(read).get(tuple(error.absolute_path))
+        as_text = f" (given as {given!r})" if given is not None else ""
+        raise ValueError(f"config: {where} = {error.instance!r}{as_text}: {error.message}")
+
+
+#: scene key -> the ``mpm.numerics`` key (or ``mpm.particle_sizes_um``) it is made from (``scene_for``); the
+#: domain's depend on its mode, the physical keys on the point (``Point.source``)
+_NUMERICS_KEYS = {
+    "discretisation.particle_size_m": "mpm.particle_sizes_um",
+    **{f"discretisation.{k}": f"mpm.numerics.{k}" for k in (
+        "particles_per_cell", "cfl", "mass_scaling", "flip", "dilatation", "graded", "fine_zone_contact_radii",
+        "fine_zone_shape", "active_zone_contact_radii")},
+    "sliding.distance_m": "mpm.numerics.sliding_distance_um",
+    "sliding.speed_m_s": "mpm.numerics.speed_m_s",
+    "sliding.experiment_speed_m_s": "mpm.numerics.experiment_speed_m_s",
+    "outputs.steady_window": "mpm.numerics.steady_window",
+    "outputs.records": "mpm.numerics.records",
+    "outputs.buried_profile_depth_m": "mpm.numerics.buried_profile_depth_um",
+    "domain.headroom_m": "mpm.numerics.domain.headroom_um",
+}
+_DOMAIN_KEYS = {"sized": {"domain.radius_m": "mpm.numerics.domain.radius_contact_radii",
+                          "domain.length_m": "mpm.numerics.domain.end_margin_contact_radii"},
+                "fixed": {"domain.radius_m": "mpm.numerics.domain.radius_um",
+                          "domain.length_m": "mpm.numerics.domain.length_um"}}
+_UNIT = re.compile(r"_(m_s|um|mm|m|N|MPa|Pa)$")
+
+
+def _unit(key: str) -> str:
+    found = _UNIT.search(key)
+    return found.group(1) if found else ""
+
+
+def in_config_terms(message: str, point: Point, numerics: dict[str, Any], rid: str) -> str:
+    """A scene's refusal with its scene keys (``discretisation.cfl``) named as the config keys they come from
+    (``mpm.numerics.cfl``; ``mpm.numerics.sliding_distance_um (in SI: sliding.distance_m)`` where the units
+    differ), and the run named."""
+    keys = _NUMERICS_KEYS | _DOMAIN_KEYS.get(numerics.get("domain", {}).get("mode"), {}) | point.source
+    shown = {k: v if _unit(k) == _unit(v) else f"{v} (in SI: {k})" for k, v in keys.items()}
+    alternatives = "|".join(re.escape(k) for k in sorted(keys, key=len, reverse=True))
+    pattern = re.compile(r"(?<![\w.])(?:scene\.)?(" + alternatives + r")(?!\w)")
+    return f"config: run {rid}: " + pattern.sub(lambda m: shown[m.group(1)], message)
+
+
 # ----------------------------------------------------------------------------- physical points
 @dataclass(frozen=True)
 class Point:
@@ -70,6 +179,9 @@ class Point:
     coating: Any | None
     interface: dict[str, Any]
     k1: float = field(default=125.0, compare=False)  # the analytical model's only: one run serves any k1
+    #: the config key each of the scene's physical keys comes from (``load_N``, ``sphere.radius_m``,
+    #: ``layers.coating_thickness_m``), so that a refused scene names what to change in the config
+    source: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     def layers(self) -> Layers:
         coating = None
@@ -118,7 +230,8 @@ def _interface(name: str, rp: dict[str, Any]) -> dict[str, Any]:
 
 
 def rigid_plastic_point(rp: dict[str, Any], ratio: float, substrate_MPa: float, thickness_um: float,
-                        interface: str, k1: float) -> Point:
+                        interface: str, k1: float, *, where: str = "mpm.rigid_plastic") -> Point:
+    """A rigid-plastic point; ``where``: the config section its thickness comes from (for messages)."""
     Hs, Hc = float(substrate_MPa), float(ratio) * float(substrate_MPa)
     iface = _interface(interface, rp)
     t = float(thickness_um)
@@ -126,21 +239,30 @@ def rigid_plastic_point(rp: dict[str, Any], ratio: float, substrate_MPa: float, 
     key = f"rp_{coated}_{_interface_key(iface)}_r{fmt(rp['radius_um'])}_F{fmt(rp['load_N'])}"
     return Point(key=key, load_N=float(rp["load_N"]), radius_m=float(rp["radius_um"]) * 1e-6, thickness_m=t * 1e-6,
                  substrate={"rigid_plastic_hardness_Pa": Hs * 1e6},
-                 coating={"rigid_plastic_hardness_Pa": Hc * 1e6} if t > 0 else None, interface=iface, k1=float(k1))
+                 coating={"rigid_plastic_hardness_Pa": Hc * 1e6} if t > 0 else None, interface=iface, k1=float(k1),
+                 source={"load_N": "mpm.rigid_plastic.load_N", "sphere.radius_m": "mpm.rigid_plastic.radius_um",
+                         "layers.coating_thickness_m": f"{where}.thickness_um"})
 
 
 def real_point(real: dict[str, Any], system: str, load_N: float, radius_um: float,
-               thickness_um: float | None = None) -> Point:
-    """``system``: ``coated`` (zinc coating on DX56), ``zinc_block`` or ``steel`` (DX56)."""
+               thickness_um: float | None = None, *, where: str = "mpm.real_materials") -> Point:
+    """``system``: ``coated`` (zinc coating on DX56), ``zinc_block`` or ``steel`` (DX56). ``where``: the config
+    section its load and radius come from (for messages): ``mpm.real_materials`` (``loads_N``, ``ball_radii_um``,
+    ``coating_thickness_um``), or its ``thickness_sweep`` or ``picture`` (``load_N``, ``radius_um``)."""
     spec = real["systems"][system]
     lub = real["lubricants"][spec["lubricant"]]
     iface = {"model": "boundary_layer", "Cp": float(lub["Cp"]), "np": float(lub["np"])}
     t = float(real["coating_thickness_um"] if thickness_um is None else thickness_um) if spec.get("coating") else 0.0
     mats = f"{spec['coating']}-on-{spec['substrate']}_t{fmt(t)}" if t > 0 else spec["substrate"]
     key = f"{mats}_{_interface_key(iface)}_r{fmt(radius_um)}_F{fmt(load_N)}"
+    top = where == "mpm.real_materials"
+    source = {"load_N": f"{where}.loads_N" if top else f"{where}.load_N",
+              "sphere.radius_m": f"{where}.ball_radii_um" if top else f"{where}.radius_um",
+              "layers.coating_thickness_m": (f"{where}.thickness_um" if thickness_um is not None
+                                             else "mpm.real_materials.coating_thickness_um")}
     return Point(key=key, load_N=float(load_N), radius_m=float(radius_um) * 1e-6, thickness_m=t * 1e-6,
                  substrate=spec["substrate"], coating=spec.get("coating") if t > 0 else None, interface=iface,
-                 k1=float(real["k1"]))
+                 k1=float(real["k1"]), source=source)
 
 
 # ----------------------------------------------------------------------------- figures
@@ -153,13 +275,14 @@ def figure_panels(config: dict[str, Any], figure: str) -> tuple[Panel, ...]:
         ratios = tuple(float(x) for x in rs["hardness_ratio"])
         a = Panel("a", "interface", "hardness_ratio", ratios, tuple(
             Series(iface, tuple(rigid_plastic_point(rp, x, rs["substrate_hardness_MPa"], rs["thickness_um"], iface,
-                                                    rs["k1"]) for x in ratios))
+                                                    rs["k1"], where="mpm.rigid_plastic.ratio_sweep") for x in ratios))
             for iface in rs["interfaces"]))
         ts = rp["thickness_sweep"]
         thick = tuple(float(x) for x in ts["thickness_um"])
+        where = "mpm.rigid_plastic.thickness_sweep"
         b = Panel("b", "coating", "thickness_um", thick, tuple(
             Series(case, tuple(rigid_plastic_point(rp, ts[case]["hardness_ratio"], ts[case]["substrate_hardness_MPa"],
-                                                   t, ts["interface"], ts["k1"]) for t in thick))
+                                                   t, ts["interface"], ts["k1"], where=where) for t in thick))
             for case in ("soft", "hard")))
         return (a, b)
     loads = tuple(float(x) for x in real["loads_N"])
@@ -180,8 +303,10 @@ def figure_panels(config: dict[str, Any], figure: str) -> tuple[Panel, ...]:
     if figure == "fig18":
         ts = real["thickness_sweep"]
         thick = tuple(float(x) for x in ts["thickness_um"])
-        coated = Series("coated", tuple(real_point(real, "coated", ts["load_N"], ts["radius_um"], t) for t in thick))
-        bulk = Series("zinc_block", (real_point(real, "zinc_block", ts["load_N"], ts["radius_um"]),))
+        where = "mpm.real_materials.thickness_sweep"
+        coated = Series("coated", tuple(real_point(real, "coated", ts["load_N"], ts["radius_um"], t, where=where)
+                                        for t in thick))
+        bulk = Series("zinc_block", (real_point(real, "zinc_block", ts["load_N"], ts["radius_um"], where=where),))
         return (Panel("t", "coated_system", "thickness_um", thick, (coated,)),
                 Panel("bulk", "block", "load_N", (float(ts["load_N"]),), (bulk,)))
     raise ValueError(f"figure = {figure!r} is not a sweep figure; sweep figures: {SWEEP_FIGURES}")
@@ -194,13 +319,16 @@ def figure_points(config: dict[str, Any], figure: str) -> dict[str, Point]:
     if figure == "fig12":
         pic = rp["picture"]
         return {"coated": rigid_plastic_point(rp, pic["hardness_ratio"], pic["substrate_hardness_MPa"],
-                                              pic["thickness_um"], pic["interface"], rp["ratio_sweep"]["k1"])}
+                                              pic["thickness_um"], pic["interface"], rp["ratio_sweep"]["k1"],
+                                              where="mpm.rigid_plastic.picture")}
     pic = real["picture"]
-    coated = real_point(real, "coated", pic["load_N"], pic["radius_um"])
+    where = "mpm.real_materials.picture"
+    coated = real_point(real, "coated", pic["load_N"], pic["radius_um"], where=where)
     if figure in ("fig14", "fig19"):
         return {"coated": coated}
     if figure == "fig17":
-        return {"coated": coated, "zinc_block": real_point(real, "zinc_block", pic["load_N"], pic["radius_um"])}
+        return {"coated": coated, "zinc_block": real_point(real, "zinc_block", pic["load_N"], pic["radius_um"],
+                                                           where=where)}
     raise ValueError(f"figure = {figure!r} is not a single-run figure; single-run figures: {SINGLE_RUN_FIGURES}")
 
 
@@ -289,7 +417,11 @@ def all_points(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -
 
 
 def all_runs(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> dict[str, dict[str, Any]]:
-    """run id -> complete scene dict (SI, JSON-serialisable) for every run the figures need."""
+    """run id -> complete scene dict (SI, JSON-serialisable) for every run the figures need.
+
+    Checks the whole config first (``check_config``: the workflow builds this matrix before any job); a scene
+    the solver refuses is named by its run and the config keys it comes from (``in_config_terms``)."""
+    check_config(config)
     points = all_points(config, figures)
     numerics = config["mpm"]["numerics"]
     wanted = {rid for fig in figures for rid in figure_runs(config, fig)}
@@ -298,7 +430,10 @@ def all_runs(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> 
         for h in particle_sizes_um(config):
             rid = run_id(p, h)
             if rid in wanted:
-                runs[rid] = scene_for(p, h, numerics).to_dict()
+                try:
+                    runs[rid] = scene_for(p, h, numerics).to_dict()
+                except ValueError as exc:
+                    raise ValueError(in_config_terms(str(exc), p, numerics, rid)) from None
     return dict(sorted(runs.items()))
 
 
