@@ -20,6 +20,7 @@ import xarray as xr
 import yaml
 
 from plough.figures import plot
+from plough.figures.style import header
 from plough.io import to_json, write_netcdf_atomic
 from plough.mpm.io import SERIES_META, STANDARD_ERROR_META, STEADY_META
 from plough.study import matrix
@@ -30,6 +31,7 @@ ROOT = Path(__file__).resolve().parents[2]
 SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
 MPM = SMOKE["mpm"]
 SIZES = [float(h) for h in MPM["particle_sizes_um"]]  # 20, 14, 10
+SCENES = matrix.all_runs(SMOKE)  # run id -> scene: what a marker records, as the workflow writes it
 ORDER = 1.5
 C = 0.002  # relative size of the discretisation error per um**ORDER
 NOISE = 0.15  # added at the middle size of noisy points: the values are then not monotone in h
@@ -297,11 +299,11 @@ def test_fig11_has_two_panels_with_suffixed_variables(run_files, tmp_path):
     _draws("fig11", _written(ds, tmp_path), tmp_path)
 
 
-def test_thickness_panel_keeps_every_mark_in_view_and_the_legend_off_the_marks(run_files):
+def test_thickness_panel_keeps_every_mark_in_view_and_the_key_off_the_marks(run_files):
     """Fig. 11b: a per-size dp far above the analytical lines and the dp = t line's reach stays in view (the
     axis used to end at 1.3x the largest per-size value, hiding extrapolated marks above it); the t axis is
-    linear to THICKNESS_LINEAR_UM and logarithmic beyond, starting left of t = 0; the legend lies below the
-    axes, where it covers no mark."""
+    linear to THICKNESS_LINEAR_UM and logarithmic beyond, starting left of t = 0; the panel has no legend of
+    its own, its entries go to the figure's key, which lies above the axes, where it covers no mark."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -314,15 +316,18 @@ def test_thickness_panel_keeps_every_mark_in_view_and_the_legend_off_the_marks(r
     ds["dp_h0_b"][{"coating": 0, "thickness_um": 1}] = high
     ds["dp_h0_b"][{"coating": 1, "thickness_um": 1}] = -0.5 * high  # an extrapolation below zero
     fig, ax = plt.subplots(layout="constrained")
-    mpm_figures._sweep_panel(ax, ds, "dp", "_b", thickness_axis=True)
+    entries = mpm_figures._sweep_panel(ax, ds, "dp", "_b", thickness_axis=True, panel="b")
+    header(fig, "fig11", entries)
     lo, hi = ax.get_ylim()
     assert lo <= -0.5 * high * 1e6 and hi >= high * 1e6
     t = ds["thickness_um"].values
     assert ax.get_xscale() == "symlog" and ax.get_xlim()[0] < 0 < t.max() < ax.get_xlim()[1]
     assert set(ax.get_xticks()) >= {0.0, 10.0} and t.min() == 0
     fig.canvas.draw()
-    legend = ax.get_legend().get_window_extent()
-    assert legend.y1 <= ax.xaxis.label.get_window_extent().y0  # below the axes and their label
+    assert ax.get_legend() is None
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert {"(b) soft coating", "(b) hard coating", "dotted: dp = t"} <= set(labels)
+    assert fig.legends[0].get_window_extent().y0 >= ax.get_tightbbox().y1 - 1  # above the axes and their title
     plt.close(fig)
     # thicknesses all past the linear range: no empty linear stretch at the left
     fig, ax = plt.subplots()
@@ -516,7 +521,7 @@ def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_fil
     from plough.study import skipping
 
     loads, r1, finest = _zinc_block_lightest()
-    paths = _with_marker(run_files, tmp_path, finest, skipping.skip_marker({"name": finest}, {}, 0.1, []))
+    paths = _with_marker(run_files, tmp_path, finest, skipping.skip_marker(SCENES[finest], {}, 0.1, []))
 
     with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
         build_dataset(SMOKE, "fig15", paths)  # skip_finest_tolerance null: a marker is a stale file
@@ -552,7 +557,7 @@ def test_a_skip_marker_at_a_coarser_size_is_refused(run_files, tmp_path):
     rid = matrix.run_id(point, max(SIZES))
     paths = dict(run_files)
     paths[rid] = tmp_path / f"{rid}.nc"
-    write_netcdf_atomic(skipping.skip_marker({"name": rid}, {}, 0.1, []), paths[rid])
+    write_netcdf_atomic(skipping.skip_marker(SCENES[rid], {}, 0.1, []), paths[rid])
     config = copy.deepcopy(SMOKE)
     config["mpm"]["skip_finest_tolerance"] = 0.05
     with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
@@ -580,6 +585,66 @@ def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
         labels = [line.get_label() for line in crossed if not line.get_label().startswith("_")]
         assert len(labels) == (1 if crosses else 0)
         plt.close(fig)
+
+
+def test_sweep_figure_draws_the_trend_over_lighter_bars(run_files):
+    """Trend first: each series' extrapolated values are joined by one line in its colour, drawn above
+    their bars, which are lighter and thinner than that line; the per-size values are faint; the y axis
+    follows the marks and lines (zero included), not the bars."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgb
+
+    from plough.figures import mpm as mpm_figures
+
+    ds = build_dataset(SMOKE, "fig15", run_files)
+    fig, ax = plt.subplots()
+    mpm_figures._sweep_panel(ax, ds, "dp", "")
+    bars = [c.lines[2][0] for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() is None]
+    assert len(bars) == ds["material"].size
+    marks = [ds["dp"].values * 1e6, ds["dp_h0"].values * 1e6, ds["dp_analytical"].values * 1e6]
+    tops = []
+    for i, label in enumerate(ds["material"].values):
+        colour = np.array(to_rgb(mpm_figures.SERIES_COLOURS[i]))
+        val = ds["dp_h0"].sel(material=label).values * 1e6
+        trend = [line for line in ax.lines if line.get_linestyle() == "-" and line.get_xdata().size == val.size
+                 and np.allclose(line.get_ydata(), val)]
+        assert len(trend) == 1 and np.allclose(to_rgb(trend[0].get_color()), colour)
+        own = [b for b in bars if np.allclose([seg[:, 1].mean() for seg in b.get_segments()], val)]
+        assert len(own) == 1
+        bar_colour = np.array(own[0].get_color()[0][:3])
+        assert np.all(bar_colour >= colour) and bar_colour.sum() > colour.sum()  # lighter: towards white
+        assert own[0].get_zorder() < trend[0].get_zorder()
+        assert own[0].get_linewidth()[0] < trend[0].get_linewidth()
+        tops.append(max(float(np.max(seg[:, 1])) for seg in own[0].get_segments()))
+    faint = [line for line in ax.lines if line.get_alpha() == mpm_figures.FAINT
+             and line.get_marker() in mpm_figures.SIZE_MARKERS]
+    assert len(faint) == ds["material"].size * ds["h"].size
+    lo, hi = ax.get_ylim()
+    every = np.concatenate([m.ravel() for m in marks])
+    assert lo <= min(0.0, every.min()) and hi >= every.max()
+    assert hi <= every.max() + 0.1 * (every.max() - min(0.0, every.min())) < max(tops)  # a bar runs past it
+    plt.close(fig)
+
+
+@pytest.mark.parametrize("figure", [*matrix.MPM_FIGURES, "fig22"])
+def test_every_mpm_figure_has_one_key_under_its_question(run_files, tmp_path, figure, monkeypatch):
+    """No legend inside a panel: one key for the figure, above the panels, titled with the figure's
+    question in one line."""
+    from plough.figures import analytical as analytical_figures
+    from plough.figures import mpm as mpm_figures
+    from tests.figures.test_style import check_header
+
+    module = analytical_figures if figure == "fig22" else mpm_figures
+    drawn = []
+    monkeypatch.setattr(module, "save", lambda fig, outputs: drawn.append(fig))
+    module.PLOTTERS[figure](_written(build_dataset(SMOKE, figure, run_files), tmp_path), [tmp_path / "f.png"])
+    check_header(drawn[0], figure)
+    import matplotlib.pyplot as plt
+
+    plt.close(drawn[0])
 
 
 def test_sweep_figure_draws_each_runs_sampling_error(run_files):
@@ -627,7 +692,7 @@ def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_file
     from plough.study import skipping
 
     loads, r1, finest = _zinc_block_lightest()
-    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker({"name": finest}, finest, "unstable run",
+    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker(SCENES[finest], finest, "unstable run",
                                                                               []))
     record = _recording()
     assert finest in matrix.failure_recordable_runs(record)
@@ -651,7 +716,7 @@ def test_a_failed_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_file
         build_dataset(SMOKE, "fig15", paths)  # the smoke config stops on a failed run
     coarse = finest.replace(f"_h{matrix.fmt(min(SIZES))}", f"_h{matrix.fmt(max(SIZES))}")
     assert coarse in run_files
-    paths = _with_marker(run_files, tmp_path, coarse, skipping.failure_marker({"name": coarse}, coarse, "unstable run",
+    paths = _with_marker(run_files, tmp_path, coarse, skipping.failure_marker(SCENES[coarse], coarse, "unstable run",
                                                                               []))
     with pytest.raises(ValueError, match=f"run '{coarse}' is a failure marker"):
         build_dataset(record, "fig15", paths)
@@ -668,7 +733,7 @@ def test_sweep_figure_rings_the_points_whose_finest_run_failed(run_files, tmp_pa
     from plough.study import skipping
 
     _, _, finest = _zinc_block_lightest()
-    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker({"name": finest}, finest, "unstable run",
+    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker(SCENES[finest], finest, "unstable run",
                                                                               []))
     record = _recording()
     for data, rings in ((build_dataset(record, "fig15", paths), 1), (build_dataset(record, "fig15", run_files), 0)):
@@ -696,7 +761,7 @@ def test_fig22_carries_and_draws_a_failed_finest_run_of_fig21(run_files, tmp_pat
     r_last = float(real["ball_radii_um"][-1])
     finest = matrix.run_id(matrix.real_point(real, "coated", loads[-1], r_last), min(SIZES))
     assert finest in matrix.failure_recordable_runs(record)
-    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker({"name": finest}, finest, "unstable run",
+    paths = _with_marker(run_files, tmp_path, finest, skipping.failure_marker(SCENES[finest], finest, "unstable run",
                                                                               []))
     ds = build_dataset(record, "fig22", paths)
     sel = {"ball_diameter_mm": 2 * r_last / 1000, "mpm_load_N": loads[-1]}
@@ -721,10 +786,10 @@ def test_a_marker_at_a_pictures_run_is_refused_naming_it(run_files, tmp_path):
     from plough.study import skipping
 
     rid = matrix.figure_runs(SMOKE, "fig19")[0]
-    marker = skipping.failure_marker({"name": rid}, rid, "a particle left the grid", [])
+    marker = skipping.failure_marker(SCENES[rid], rid, "a particle left the grid", [])
     paths = _with_marker(run_files, tmp_path, rid, marker)
     with pytest.raises(ValueError, match=f"run '{rid}' is a failure marker .*a particle left the grid.*fig19 draws"):
         build_dataset(SMOKE, "fig19", paths)
-    write_netcdf_atomic(skipping.skip_marker({"name": rid}, {}, 0.1, ["a.nc"]), paths[rid])
+    write_netcdf_atomic(skipping.skip_marker(SCENES[rid], {}, 0.1, ["a.nc"]), paths[rid])
     with pytest.raises(ValueError, match=f"run '{rid}' is a skip marker"):
         build_dataset(SMOKE, "fig19", paths)

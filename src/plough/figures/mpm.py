@@ -5,14 +5,26 @@ analytical lines, the coating-wear region shaded where dp > t, and pictures from
 from __future__ import annotations
 
 import json
+import re
 
 import numpy as np
 import xarray as xr
-from matplotlib.patches import Circle
+from matplotlib.artist import Artist
+from matplotlib.lines import Line2D
+from matplotlib.patches import Circle, Patch
 from matplotlib.ticker import FixedFormatter, FixedLocator, NullLocator
-from matplotlib.transforms import offset_copy
 
-from plough.figures.style import FAILED_FINEST_LABEL, caption, new_figure, ring, save, shade_where
+from plough.figures.style import (
+    FAILED_FINEST_LABEL,
+    SideBySide,
+    axes_entries,
+    header,
+    lighter,
+    new_figure,
+    ring,
+    save,
+    shade_where,
+)
 
 SERIES_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange"]
 SIZE_MARKERS = ["^", "s", "v", "D", "P"]
@@ -21,28 +33,47 @@ THICKNESS_LINEAR_UM = 10.0
 THICKNESS_TICKS_UM = (0, 2, 4, 6, 8, 10, 20, 50, 100, 200, 500, 1000)
 QUANTITY = {"dp": ("ploughing depth dp (µm)", 1e6), "mu": ("friction coefficient mu (-)", 1.0),
             "penetration": ("penetration under load (µm)", 1e6)}
-FINDINGS = {
-    "fig11": "Paper: MPM and analytical dp agree for H~ >= 0.5; below, the soft coating piles up, stacks and "
-             "wears (CW). MPM slope change (dp = t) at t = 5.75 µm (soft) and 4.3 µm (hard).",
-    "fig13": "Paper: MPM and analytical mu agree for H~ >= 0.5; the analytical mu changes regime at "
-             "t = 6.5 µm (soft) and 7.8 µm (hard).",
-    "fig15": "Paper: zinc ploughs deeper than DX56 steel at every load and its dp grows faster.",
-    "fig16": "Paper: the 3 mm ball ploughs less than the 1 mm ball.",
-    "fig18": "Paper: dp grows with the coating thickness (the effective hardness falls) towards bulk zinc.",
-    "fig20": "Paper: zinc's friction is slightly above steel's above 7 N.",
-    "fig21": "Paper: with the 1 mm ball mu rises steadily with load; with the 3 mm ball it is lower and nearly "
-             "constant.",
-    "fig23": "Paper: the zinc coating gives the lowest friction of the three.",
-}
+#: the extrapolated marks and the line joining them (the trend), drawn above their bars
+MARK_SIZE = 6.0
+TREND_WIDTH = 1.6
+#: per-size values: faint, under everything else
+FAINT = 0.3
+#: the key's entries for the flags and encodings the sweep figures share
+UNSTEADY_LABEL = "x: run not steady (mu_drift or prow growth in its window)"
+FLAGGED_LABEL = "hollow: extrapolation flagged (least squares / two sizes)"
+WORN_LABEL = "shaded: coating worn through (MPM dp > t)"
+SERIES_NAMES = {"zinc_block": "zinc block", "steel": "DX56 steel", "coated": "zinc-coated steel"}
 
 
 def _label(value: object) -> str:
     return str(value).replace("_", " ")
 
 
+def _series_name(series_dim: str, label: object) -> str:
+    """A series' name in the key: 'soft coating', 'constant interface', '1 mm ball', 'DX56 steel'."""
+    label = str(label)
+    ball = re.fullmatch(r"r([0-9.]+)um", label)
+    if series_dim == "ball" and ball:
+        return f"{2.0 * float(ball[1]) / 1000.0:g} mm ball"
+    if series_dim == "interface":
+        return f"{label} interface"
+    if series_dim == "coating":
+        return f"{label} coating"
+    return SERIES_NAMES.get(label, _label(label))
+
+
+def _axis_label(da: xr.DataArray) -> str:
+    units = da.attrs.get("units", "1")
+    return da.attrs.get("long_name", da.name) + ("" if units == "1" else f" ({units.replace('um', 'µm')})")
+
+
 def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool = False,
-                 thickness_axis: bool = False, thickness_um: float | None = None) -> None:
-    """One panel: every series of the figure along its axis."""
+                 thickness_axis: bool = False, thickness_um: float | None = None, panel: str = "",
+                 extra_marks: tuple[float, ...] = ()) -> list[tuple[Artist, str]]:
+    """One panel: every series of the figure along its axis. The trend first: the extrapolated marks
+    joined by a line, their bars lighter and thinner behind them, the per-size values faint; the y axis
+    follows the marks and lines (bars may leave it). Returns the panel's entries of the figure's key
+    (``panel``: the panel's letter, which prefixes its series' names)."""
     name, scale = QUANTITY[quantity]
     per_size = ds[quantity + suffix]
     series_dim, axis = per_size.dims[0], per_size.dims[1]
@@ -50,22 +81,27 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
     h_values = ds["h"].values
     steady = ds.get(f"steady{suffix}")  # per run; absent for result files from before the check
     error = ds.get(f"{quantity}_standard_error{suffix}")  # per run (mu, mu_pl, mu_sh, dp); absent in old files
-    unsteady_label = "run not steady (mu_drift or prow growth in its window)"
-    failed_label = FAILED_FINEST_LABEL
+    unsteady_label, failed_label = UNSTEADY_LABEL, FAILED_FINEST_LABEL
+    prefix = f"({panel}) " if panel else ""
+    series_entries: list[tuple[Artist, str]] = []
+    flag_entries: list[tuple[Artist, str]] = []
+    any_flagged = any_analytical = False
     for i, label in enumerate(ds[series_dim].values):
         colour = SERIES_COLOURS[i % len(SERIES_COLOURS)]
         sel = {series_dim: label}
-        for k, h in enumerate(h_values):
+        for k in range(h_values.size):
             y = per_size.sel(sel).isel(h=k).values * scale
-            ax.plot(x, y, ls="none", marker=SIZE_MARKERS[k % 5], ms=3.5,
-                    color=colour, alpha=0.3, label=f"h = {h:g} µm" if i == 0 else None)
+            ax.plot(x, y, ls="none", marker=SIZE_MARKERS[k % 5], ms=3.5, color=colour, alpha=FAINT, zorder=1.5)
             if error is not None:  # the run's own sampling error; none drawn where it was not estimable
                 yerr = np.nan_to_num(error.sel(sel).isel(h=k).values * scale, nan=0.0)
-                ax.errorbar(x, y, yerr=yerr, ls="none", color=colour, alpha=0.3, elinewidth=0.8)
+                ax.errorbar(x, y, yerr=yerr, ls="none", color=colour, alpha=FAINT, elinewidth=0.6, zorder=1.5)
             if steady is not None:
                 bad = steady.sel(sel).isel(h=k).values == 0
                 if bad.any():
-                    ax.plot(x[bad], y[bad], ls="none", marker="x", ms=5, color="k", label=unsteady_label)
+                    line, = ax.plot(x[bad], y[bad], ls="none", marker="x", ms=4.5, mew=0.9, color="k", zorder=2.5,
+                                    label=unsteady_label)
+                    if unsteady_label:
+                        flag_entries.append((line, unsteady_label))
                     unsteady_label = None
         val = ds[f"{quantity}_h0{suffix}"].sel(sel).values * scale
         unc = ds[f"{quantity}_h0_uncertainty{suffix}"].sel(sel).values * scale
@@ -73,20 +109,27 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
         if sampling is not None:  # the runs' own noise carried to the limit, in quadrature with the GCI
             unc = np.hypot(unc, np.nan_to_num(sampling.sel(sel).values * scale, nan=0.0))
         flagged = ds[f"{quantity}_h0_flagged{suffix}"].sel(sel).values.astype(bool)
-        ax.errorbar(x[~flagged], val[~flagged], yerr=unc[~flagged], fmt="o", color=colour, capsize=3,
-                    label=f"MPM h -> 0, {_label(label)}")
+        any_flagged |= bool(flagged.any())
+        ax.errorbar(x, val, yerr=unc, fmt="none", ecolor=lighter(colour), elinewidth=1.0, capsize=2, zorder=2)
+        ax.plot(x, val, color=colour, lw=TREND_WIDTH, zorder=3)
+        ax.plot(x[~flagged], val[~flagged], ls="none", marker="o", ms=MARK_SIZE, color=colour, zorder=4)
         if flagged.any():
-            ax.errorbar(x[flagged], val[flagged], yerr=unc[flagged], fmt="o", mfc="white", color=colour, capsize=3,
-                        label="MPM h -> 0, flagged (not converged: least squares / two sizes)")
+            ax.plot(x[flagged], val[flagged], ls="none", marker="o", ms=MARK_SIZE, mfc="white", color=colour,
+                    zorder=4)
+        series_entries.append((Line2D([], [], color=colour, lw=TREND_WIDTH, marker="o", ms=MARK_SIZE),
+                               prefix + _series_name(series_dim, label)))
         failed = ds.get(f"failed_finest{suffix}")  # absent in datasets from before mpm.finest_failure
         if failed is not None:
             stopped = failed.sel(sel).values.astype(bool)
             if stopped.any():
                 ring(ax, x[stopped], val[stopped], failed_label)
+                if failed_label:
+                    flag_entries.append((ax.lines[-1], failed_label))
                 failed_label = None
         ana = f"{quantity}_analytical{suffix}"
         if ana in ds:
-            ax.plot(x, ds[ana].sel(sel) * scale, color=colour, lw=1.3, label=f"analytical, {_label(label)}")
+            any_analytical = True
+            ax.plot(x, ds[ana].sel(sel) * scale, color=colour, lw=1.2, ls="--", zorder=2.8)
     dp = ds.get(f"dp_h0{suffix}")
     if dp is not None:
         if thickness_axis:
@@ -96,27 +139,45 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
         else:
             worn = None
         if worn is not None and worn.any():
-            shade_where(ax, x, worn, label=f"coating wear (CW): MPM dp > t ({_label(ds[series_dim].values[0])})")
+            shade_where(ax, x, worn, label=WORN_LABEL)
+            flag_entries.append((ax.collections[-1], WORN_LABEL))
     if thickness_axis and quantity == "dp":
-        ax.plot(x, x, color="0.5", ls=":", lw=1, label="dp = t")
-        # the dp = t line would stretch the axis to the bulk coating's 200 um: the axis follows the marks and
-        # the analytical lines (every per-size and extrapolated value in view, a negative extrapolation too;
-        # bars may leave it)
-        values = [per_size.values, ds[f"{quantity}_h0{suffix}"].values]
-        if f"{quantity}_analytical{suffix}" in ds:
-            values.append(ds[f"{quantity}_analytical{suffix}"].values)
-        marks = np.concatenate([v.ravel() for v in values]) * scale
-        marks = marks[np.isfinite(marks)]
-        if marks.size:
-            ax.set_ylim(min(0.0, 1.15 * float(marks.min())), 1.15 * max(float(marks.max()), 1e-9))
-    if logx:
+        line, = ax.plot(x, x, color="0.5", ls=":", lw=1, label="dotted: dp = t")
+        flag_entries.append((line, "dotted: dp = t"))
+    _follow_marks(ax, [per_size.values * scale, ds[f"{quantity}_h0{suffix}"].values * scale,
+                       *([ds[f"{quantity}_analytical{suffix}"].values * scale] if any_analytical else []),
+                       np.asarray(extra_marks, dtype=float)])
+    if logx:  # ticks at the swept values, written plainly (0.5, 2), not as powers of ten
         ax.set_xscale("log")
+        ax.xaxis.set_major_locator(FixedLocator(x))
+        ax.xaxis.set_major_formatter(FixedFormatter([f"{v:g}" for v in x]))
+        ax.xaxis.set_minor_locator(NullLocator())
     if thickness_axis:  # linear over the thin coatings where dp crosses t, logarithmic out to the bulk coating
         _thickness_axis(ax, x)
-    ax.set_xlabel(ds[axis].attrs.get("long_name", axis) + (f" ({ds[axis].attrs['units']})"
-                                                           if ds[axis].attrs.get("units", "1") != "1" else ""))
+    ax.set_xlabel(_axis_label(ds[axis]))
     ax.set_ylabel(name)
-    _legend_below(ax)
+    sizes = SideBySide(Line2D([], [], ls="none", marker=SIZE_MARKERS[k % 5], ms=4, color="0.3", alpha=0.6)
+                  for k in range(h_values.size))
+    style_entries = [(Line2D([], [], color="k", lw=TREND_WIDTH, marker="o", ms=MARK_SIZE),
+                      "line + marks: MPM extrapolated to h -> 0"),
+                     *([(Line2D([], [], color="k", lw=1.2, ls="--"), "dashed: analytical model")]
+                       if any_analytical else []),
+                     *([(Line2D([], [], ls="none", color="k", marker="o", ms=MARK_SIZE, mfc="white"),
+                         FLAGGED_LABEL)] if any_flagged else []),
+                     (sizes, "faint: per size, h = " + ", ".join(f"{h:g}" for h in h_values) + " µm")]
+    return [*series_entries, *style_entries, *flag_entries]
+
+
+def _follow_marks(ax, values: list[np.ndarray]) -> None:
+    """The y axis from zero (or the lowest mark) to the highest mark, per-size value or analytical value:
+    the trend fills the panel, and a bar longer than the spread of the marks runs past the edge."""
+    marks = np.concatenate([np.ravel(v) for v in values])
+    marks = marks[np.isfinite(marks)]
+    if not marks.size:
+        return
+    lo, hi = min(0.0, float(marks.min())), max(float(marks.max()), 0.0)
+    pad = 0.08 * (hi - lo) if hi > lo else max(abs(hi), 1e-9)
+    ax.set_ylim(lo - (pad if lo < 0 else 0.0), hi + pad)
 
 
 def _thickness_axis(ax, x: np.ndarray) -> None:
@@ -133,36 +194,22 @@ def _thickness_axis(ax, x: np.ndarray) -> None:
         ax.axvline(THICKNESS_LINEAR_UM, color="0.8", lw=0.6, zorder=0)
 
 
-#: points between the axes' bottom and the legend's top: below the tick labels and the axis label
-LEGEND_DROP_PT = 34.0
-
-
-def _legend_below(ax) -> None:
-    """The sweep panels' legend under the axes and their label (inside the axes it covered marks); the gap
-    is in points, so that it clears the label whatever the panel's height."""
-    below = offset_copy(ax.transAxes, fig=ax.figure, y=-LEGEND_DROP_PT, units="points")
-    ax.legend(fontsize=6.5, loc="upper center", bbox_to_anchor=(0.5, 0.0), bbox_transform=below, ncol=1,
-              frameon=False)
-
-
-def _scene_note(ds: xr.Dataset) -> str:
-    return f"Particle sizes h = {', '.join(f'{h:g}' for h in ds['h'].values)} µm; marks: extrapolated to h -> 0 " \
-           "(Richardson; bars: Roache GCI and the runs' sampling errors carried to the limit, in quadrature, " \
-           "the GCI alone where a run's error is missing; " \
-           "hollow = fallback, flagged; ringed = the finest run stopped unstable, from the two coarser sizes), " \
-           "faint: per size with the run's sampling standard error; " \
-           "lines: analytical model."
-
-
 def _fig11_13(ds: xr.Dataset, outputs, quantity: str, figure: str) -> None:
-    fig, axes = new_figure(1, 2, height_per_row=5.6)
+    fig, axes = new_figure(1, 2, height_per_row=4.4)
     t_a = float(ds.attrs.get("ratio_sweep_thickness_um", np.nan))
-    _sweep_panel(axes[0, 0], ds, quantity, "_a", logx=True, thickness_um=t_a if np.isfinite(t_a) else None)
+    a = _sweep_panel(axes[0, 0], ds, quantity, "_a", logx=True, thickness_um=t_a if np.isfinite(t_a) else None,
+                     panel="a")
     axes[0, 0].set_title("(a) vs hardness ratio H~", fontsize=10)
-    _sweep_panel(axes[0, 1], ds, quantity, "_b", thickness_axis=True)
+    b = _sweep_panel(axes[0, 1], ds, quantity, "_b", thickness_axis=True, panel="b")
     axes[0, 1].set_title("(b) vs coating thickness t", fontsize=10)
-    caption(fig, f"{ds.attrs['title']}. {_scene_note(ds)} {FINDINGS[figure]}")
+    header(fig, figure, _series_first(a, b), ncol=4)
     save(fig, outputs)
+
+
+def _series_first(*panels: list[tuple[Artist, str]]) -> list[tuple[Artist, str]]:
+    """The panels' entries with every panel's series names ahead of the shared encodings."""
+    named = [e for p in panels for e in p if e[1].startswith("(")]
+    return [*named, *(e for p in panels for e in p if not e[1].startswith("("))]
 
 
 def plot_fig11(ds: xr.Dataset, outputs) -> None:
@@ -175,48 +222,56 @@ def plot_fig13(ds: xr.Dataset, outputs) -> None:
 
 def _vs_load(quantity: str, figure: str):
     def plot(ds: xr.Dataset, outputs) -> None:
-        fig, axes = new_figure(1, 1, width=6.5, height_per_row=5.8)
-        _sweep_panel(axes[0, 0], ds, quantity, "")
-        caption(fig, f"{ds.attrs['title']}. {_scene_note(ds)} {FINDINGS[figure]}")
+        fig, axes = new_figure(1, 1, width=6.5, height_per_row=4.4)
+        entries = _sweep_panel(axes[0, 0], ds, quantity, "")
+        header(fig, figure, entries, ncol=2)
         save(fig, outputs)
 
     return plot
 
 
 def plot_fig18(ds: xr.Dataset, outputs) -> None:
-    fig, axes = new_figure(1, 1, width=6.5, height_per_row=5.8)
+    fig, axes = new_figure(1, 1, width=6.5, height_per_row=4.4)
     ax = axes[0, 0]
-    _sweep_panel(ax, ds, "dp", "_t")
     bulk = float(ds["dp_h0_bulk"].values.ravel()[0]) * 1e6
     unc = float(ds["dp_h0_uncertainty_bulk"].values.ravel()[0]) * 1e6
+    entries = _sweep_panel(ax, ds, "dp", "_t", extra_marks=(bulk,))
     ax.axhspan(bulk - unc, bulk + unc, color="0.85", zorder=0)
-    ax.axhline(bulk, color="k", ls="--", label="MPM h -> 0, bulk zinc")
-    _legend_below(ax)
-    caption(fig, f"{ds.attrs['title']}. {_scene_note(ds)} {FINDINGS['fig18']}")
+    line = ax.axhline(bulk, color="k", ls="-.", lw=1.2, zorder=2.8)
+    band = (Patch(color="0.85"), line)
+    header(fig, "fig18", [*entries, (band, "dash-dot: bulk zinc, MPM h -> 0 (band: its uncertainty)")], ncol=2)
     save(fig, outputs)
 
 
 # ----------------------------------------------------------------------------- single-run figures
-def _forces(ax, ds: xr.Dataset, case: str, names=("Fx", "Fz", "Fx_pl", "Fx_sh")) -> None:
+FORCE_STYLES = {"Fx": ("k", "-", "Fx: tangential force"), "Fz": ("tab:blue", "-", "Fz: normal force"),
+                "Fx_pl": ("tab:green", "--", "Fx_pl: ploughing part of Fx"),
+                "Fx_sh": ("tab:orange", "--", "Fx_sh: shear part of Fx")}
+
+
+def _forces(ax, ds: xr.Dataset, case: str, names=("Fx", "Fz", "Fx_pl", "Fx_sh"), window_note: str = "") -> None:
     sub = ds.sel(case=case)
     s = sub["sliding_distance"].values * 1e6
     ok = np.isfinite(s)
-    styles = {"Fx": ("k", "-"), "Fz": ("tab:blue", "-"), "Fx_pl": ("tab:green", "--"), "Fx_sh": ("tab:orange", "--")}
     for n in names:
-        c, ls = styles[n]
-        ax.plot(s[ok], sub[n].values[ok], color=c, ls=ls, lw=1, label=n)
+        c, ls, label = FORCE_STYLES[n]
+        ax.plot(s[ok], sub[n].values[ok], color=c, ls=ls, lw=1, label=label)
     window = sub["in_steady_window"].values[ok].astype(bool)
-    shade_where(ax, s[ok], window, label="steady window (means)")
-    ax.axhline(float(sub["Fz_mean"]), color="tab:blue", lw=0.6, ls=":")
+    shade_where(ax, s[ok], window, label="shaded: steady window (means)" + window_note)
+    ax.axhline(float(sub["Fz_mean"]), color="tab:blue", lw=0.6, ls=":", label="dotted: mean Fz in the window")
     ax.set_xlabel("sliding distance (µm)")
     ax.set_ylabel("force on the sphere (N)")
-    ax.legend(fontsize=7)
 
 
 def _material_scatter(ax, u, v, coating, size: float) -> None:
     colours = np.where(np.asarray(coating) > 0.5, "tab:red", "0.55")
     ax.scatter(u, v, s=size, c=colours, marker="s", linewidths=0)
     ax.set_aspect("equal")
+
+
+def _material_entries(panel: str, substrate: str) -> list[tuple[Artist, str]]:
+    return [(Line2D([], [], ls="none", marker="s", ms=5, color="tab:red"), f"({panel}) coating particles"),
+            (Line2D([], [], ls="none", marker="s", ms=5, color="0.55"), f"({panel}) {substrate} particles")]
 
 
 def plot_fig12(ds: xr.Dataset, outputs) -> None:
@@ -229,17 +284,16 @@ def plot_fig12(ds: xr.Dataset, outputs) -> None:
     scene = json.loads(ds.attrs["scene_coated"])
     centre = np.asarray(ds.attrs["sphere_centre_end_m_coated"])
     r = scene["sphere"]["radius_m"] * 1e6
-    ax.add_patch(Circle((centre[0] * 1e6, centre[2] * 1e6), r, fill=False, color="k"))
+    ax.add_patch(Circle((centre[0] * 1e6, centre[2] * 1e6), r, fill=False, color="k", label="sphere"))
     xm = sub["midplane_x"].values[ok] * 1e6
     ax.set_xlim(xm.min(), xm.max())
     ax.set_ylim(sub["midplane_z"].values[ok].min() * 1e6, 0.25 * (xm.max() - xm.min()))
     ax.set_xlabel("x (µm), sliding to +x")
     ax.set_ylabel("z (µm)")
-    ax.set_title("(a) mid-plane y = 0 at the end of the slide: coating (red), substrate (grey)", fontsize=9)
+    ax.set_title("(a) mid-plane y = 0 at the end of the slide", fontsize=10)
     _forces(axes[0, 1], ds, "coated")
-    axes[0, 1].set_title("(b) forces on the sphere vs sliding distance", fontsize=10)
-    caption(fig, f"{ds.attrs['title']} (h = {ds.attrs['particle_size_um']:g} µm, finest run). Paper: the soft "
-            "coating piles up ahead of the sphere and stacks (coating wear) for H~ < 0.5.")
+    axes[0, 1].set_title("(b) forces on the sphere", fontsize=10)
+    header(fig, "fig12", [*_material_entries("a", "substrate"), *axes_entries(axes)], ncol=3)
     save(fig, outputs)
 
 
@@ -259,24 +313,22 @@ def plot_fig14(ds: xr.Dataset, outputs) -> None:
     ax.set_ylabel("y (µm)")
     ax.set_title("(a) top view: residual surface height", fontsize=10)
     ax = axes[0, 1]
-    ax.plot(hx, hmap[:, 0], color="k", label="groove bottom (y = 0)")
-    ax.plot(hx, np.nanmax(hmap, axis=1), color="tab:red", label="highest pile-up across y")
+    ax.plot(hx, hmap[:, 0], color="k", label="(b) groove bottom (y = 0)")
+    ax.plot(hx, np.nanmax(hmap, axis=1), color="tab:red", label="(b) highest pile-up across y")
     ax.set_xlabel("x (µm)")
     ax.set_ylabel("height (µm)")
     ax.set_title("(b) along the scratch", fontsize=10)
-    ax.legend(fontsize=7)
     ax = axes[1, 0]
     y = ds["y"].values * 1e6
     z = sub["profile_z"].values * 1e6
     ax.plot(np.concatenate([-y[::-1], y]), np.concatenate([z[::-1], z]), color="k")
     dg, hpu, dp = (float(sub[v]) * 1e6 for v in ("dg", "hpu", "dp"))
     ax.axhline(0, color="0.6", lw=0.7)
-    ax.axhline(-dg, color="tab:blue", ls="--", label=f"dg = {dg:.3g} µm")
-    ax.axhline(hpu, color="tab:red", ls="--", label=f"hpu = {hpu:.3g} µm")
+    ax.axhline(-dg, color="tab:blue", ls="--", label=f"(c) groove depth dg = {dg:.3g} µm")
+    ax.axhline(hpu, color="tab:red", ls="--", label=f"(c) pile-up height hpu = {hpu:.3g} µm")
     ax.set_title(f"(c) residual cross-section: dp = dg + hpu = {dp:.3g} µm", fontsize=10)
     ax.set_xlabel("y (µm)")
     ax.set_ylabel("z (µm)")
-    ax.legend(fontsize=7)
     ax = axes[1, 1]
     ok = np.isfinite(sub["section_y"].values)
     yy, zz = sub["section_y"].values[ok] * 1e6, sub["section_z"].values[ok] * 1e6
@@ -284,38 +336,34 @@ def plot_fig14(ds: xr.Dataset, outputs) -> None:
     _material_scatter(ax, np.concatenate([-yy, yy]), np.concatenate([zz, zz]), np.concatenate([cc, cc]), 3)
     ax.set_xlabel("y (µm)")
     ax.set_ylabel("z (µm)")
-    ax.set_title("(d) particles of the cross-section: coating (red), steel (grey)", fontsize=10)
-    caption(fig, f"{ds.attrs['title']} (h = {ds.attrs['particle_size_um']:g} µm, finest run; the simulated half "
-            "is mirrored at y = 0). Paper: the coating is pushed aside into pile-ups and thinned under the track.")
+    ax.set_title("(d) particles of the cross-section", fontsize=10)
+    header(fig, "fig14", [*axes_entries(axes), *_material_entries("d", "steel")], ncol=3)
     save(fig, outputs)
 
 
 def plot_fig17(ds: xr.Dataset, outputs) -> None:
     fig, axes = new_figure(1, 2, height_per_row=4.0)
     y = ds["y"].values * 1e6
-    for ax, var, title in ((axes[0, 0], "profile_z", "(a) surface"),
-                           (axes[0, 1], "buried_profile_z", "(b) material line that started at 15 µm depth")):
+    depth = json.loads(ds.attrs[f"scene_{ds['case'].values[0]}"])["outputs"]["buried_profile_depth_m"] * 1e6
+    for ax, var, panel in ((axes[0, 0], "profile_z", "(a) surface"),
+                           (axes[0, 1], "buried_profile_z", f"(b) material line that started at {depth:g} µm depth")):
         for i, case in enumerate(ds["case"].values):
             z = ds[var].sel(case=case).values * 1e6
             ax.plot(np.concatenate([-y[::-1], y]), np.concatenate([z[::-1], z]), color=SERIES_COLOURS[i],
-                    label=_label(case))
+                    label=SERIES_NAMES.get(str(case), _label(case)))
         ax.set_xlabel("y (µm)")
         ax.set_ylabel("z (µm)")
-        ax.set_title(title, fontsize=10)
-        ax.legend(fontsize=8)
-    caption(fig, f"{ds.attrs['title']} (h = {ds.attrs['particle_size_um']:g} µm, finest runs). For the coated "
-            "steel the line at 15 µm depth is the coating-steel interface. Paper: the coating deforms with a "
-            "shallower groove than the zinc block, and the steel below is hardly deformed.")
+        ax.set_title(panel, fontsize=10)
+    header(fig, "fig17", axes_entries(axes))
     save(fig, outputs)
 
 
 def plot_fig19(ds: xr.Dataset, outputs) -> None:
     fig, axes = new_figure(1, 1, width=7.0, height_per_row=4.2)
-    _forces(axes[0, 0], ds, "coated")
     sub = ds.sel(case="coated")
-    caption(fig, f"{ds.attrs['title']} (h = {ds.attrs['particle_size_um']:g} µm, finest run): mu = "
-            f"{float(sub['mu']):.3g} (analytical {float(sub['mu_analytical']):.3g}). Paper: the forces settle "
-            "within the first half of the slide; the paper averages over 0.3-0.6 mm.")
+    _forces(axes[0, 0], ds, "coated", window_note=f": mu = {float(sub['mu']):.3g} "
+                                                  f"(analytical {float(sub['mu_analytical']):.3g})")
+    header(fig, "fig19", axes_entries(axes), ncol=2)
     save(fig, outputs)
 
 

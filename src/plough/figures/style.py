@@ -1,16 +1,22 @@
-"""Shared look of plough's figures: Agg backend, sizes, colours, caption-like titles."""
+"""Shared look of plough's figures: Agg backend, sizes, colours, a one-line title (the figure's
+question) and one shared key per figure."""
 
 from __future__ import annotations
 
 import os
-import textwrap
 from pathlib import Path
 
 import matplotlib
+import numpy as np
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+from matplotlib.artist import Artist  # noqa: E402
+from matplotlib.colors import to_rgb  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
+from matplotlib.legend import Legend  # noqa: E402
+from matplotlib.legend_handler import HandlerTuple  # noqa: E402
+from matplotlib.lines import Line2D  # noqa: E402
 
 from plough.io import temporary_beside  # noqa: E402
 
@@ -26,15 +32,86 @@ def new_figure(nrows: int, ncols: int, width: float = 10.0, height_per_row: floa
     return fig, axes
 
 
-#: caption characters per inch of figure width at its 9.5 pt font (130 on the 10-inch two-panel figures)
-CAPTION_CHARS_PER_INCH = 13.0
+#: each figure's title: the question it answers, in one line. What was computed and how (particle sizes,
+#: extrapolation, what the marks and flags mean, the paper's finding) is its caption in the report
+#: (workflow/report/figure.rst).
+QUESTIONS = {
+    "fig03": "Fig. 3: How does the analytical friction change with the coating's thickness and hardness?",
+    "fig04": "Fig. 4: How deep does the sphere plough as the coating's thickness and hardness change?",
+    "fig11": "Fig. 11: Does the MPM ploughing depth follow the analytical model over hardness and thickness?",
+    "fig12": "Fig. 12: Does the soft coating pile up ahead of the sphere, and do the forces settle?",
+    "fig13": "Fig. 13: Does the MPM friction follow the analytical model over hardness and thickness?",
+    "fig14": "Fig. 14: Where does the zinc coating go when the ball ploughs it?",
+    "fig15": "Fig. 15: Does zinc plough deeper than DX56 steel as the load rises?",
+    "fig16": "Fig. 16: Does the larger ball plough less into zinc-coated steel?",
+    "fig17": "Fig. 17: Is the coated steel's groove shallower than the zinc block's, at the surface and below?",
+    "fig18": "Fig. 18b: Does the groove deepen towards bulk zinc's as the coating thickens?",
+    "fig19": "Fig. 19: Do the forces on the sphere settle while it slides?",
+    "fig20": "Fig. 20: Does zinc give more friction than DX56 steel as the load rises?",
+    "fig21": "Fig. 21: How does the friction change with load for the two ball sizes?",
+    "fig22": "Fig. 22: Do the paper's power-law fits describe the MPM friction?",
+    "fig23": "Fig. 23a: Which gives the lowest friction: zinc-coated steel, zinc or DX56 steel?",
+}
+
+#: font size of the one-line title (the figure's question) and of the shared key
+TITLE_FONTSIZE = 11.0
+KEY_FONTSIZE = 8.0
 
 
-def caption(fig: Figure, text: str) -> None:
-    """The figure's caption above the panels, wrapped to the figure's width (a fixed width cut the
-    captions of the 6.5-inch single-panel figures at the right edge)."""
-    width = int(CAPTION_CHARS_PER_INCH * fig.get_figwidth())
-    fig.suptitle("\n".join(textwrap.wrap(text, width)), fontsize=9.5, ha="left", x=0.01)
+def header(fig: Figure, figure: str, entries: list[tuple[Artist, str]], ncol: int | None = None) -> Legend:
+    """The figure's question (QUESTIONS) in one line and, under it, the figure's one key, above the
+    panels (never a legend per panel). ``entries``: (handle, label) pairs in reading order, row by
+    row; a label seen before is dropped, so panels may each hand in the same entry. The question is
+    the key's title, so that the layout stacks the two (a suptitle and a figure legend overlap)."""
+    handles, labels = [], []
+    for handle, label in entries:
+        if label not in labels:
+            handles.append(handle)
+            labels.append(label)
+    if ncol is None:  # as many columns as the width takes at about 2.4 inches an entry
+        ncol = int(fig.get_figwidth() // 2.4)
+    ncol = max(1, min(len(handles), ncol))
+    order = _row_major(len(handles), ncol)
+    legend = fig.legend([handles[i] for i in order], [labels[i] for i in order], loc="outside upper center",
+                        ncol=ncol, fontsize=KEY_FONTSIZE, frameon=False, columnspacing=1.2, handlelength=2.2,
+                        title=QUESTIONS[figure], title_fontsize=TITLE_FONTSIZE, alignment="center",
+                        handler_map={SideBySide: HandlerTuple(ndivide=None)})
+    for i, text in zip(order, legend.get_texts(), strict=True):
+        if isinstance(handles[i], Artist) and handles[i].get_gid() == "note":
+            text.set_color(handles[i].get_color())
+    return legend
+
+
+def _row_major(n: int, ncol: int) -> list[int]:
+    """The order in which to hand n entries to a legend of ncol columns (which fills column by column,
+    the first columns one longer) so that they read row by row."""
+    nrows = -(-n // ncol)
+    return [r * ncol + c for c in range(ncol) for r in range(nrows) if r * ncol + c < n]
+
+
+class SideBySide(tuple):
+    """A key handle of several markers drawn side by side (a plain tuple overlays them)."""
+
+
+def axes_entries(axes) -> list[tuple[Artist, str]]:
+    """The (handle, label) pairs of every labelled artist of ``axes``, for header(): a panel's own entries
+    ('(a) soft coating') first, shaded regions last."""
+    entries = []
+    for ax in np.ravel(axes):
+        handles, labels = ax.get_legend_handles_labels()
+        entries.extend(zip(handles, labels, strict=True))
+    return sorted(entries, key=lambda e: 0 if e[1].startswith("(") else 2 if e[1].startswith("shaded") else 1)
+
+
+def note_entry(colour: str = "k") -> Artist:
+    """A key handle that draws nothing: its entry is a note, its text in ``colour`` (header() colours it)."""
+    return Line2D([], [], ls="none", marker="none", color=colour, gid="note")
+
+
+def lighter(colour: str, amount: float = 0.55) -> tuple[float, float, float]:
+    """``colour`` mixed with white (``amount`` 0: unchanged, 1: white), for error bars behind their marks."""
+    rgb = np.asarray(to_rgb(colour))
+    return tuple(rgb + (1.0 - rgb) * amount)
 
 
 def shade_where(ax, x, mask, label: str | None = None) -> None:
