@@ -1,4 +1,4 @@
-"""Command line: ``plough analytical ...`` and ``plough mpm SCENE.yaml ...``.
+"""Command line: ``plough analytical ...``, ``plough mpm SCENE.yaml ...`` and ``plough plan ...``.
 
 Bad input gives a one-line message naming the parameter and exit code 2, never a traceback; Ctrl-C gives one
 line and exit code 130, and leaves no partial file (results and snapshots are written atomically).
@@ -172,7 +172,19 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True, parser_class=_Parser)
     _add_analytical(sub)
     _add_mpm(sub)
+    _add_plan(sub)
     return parser
+
+
+def _add_plan(sub: argparse._SubParsersAction) -> None:
+    from plough.study.plan import add_arguments, run_plan  # light: the matrix and the cost model load on use
+
+    p = sub.add_parser("plan", help="projected wall time of the workflow, per figure and in total, before it runs",
+                       description="Project the wall time of `snakemake --cores N [--configfile FILE ...]`, per "
+                       "figure and in total, here and per cluster job, from the cost model calibrated by the "
+                       "measured workflow runs (plough.study.plan). Run it in the repository root.")
+    add_arguments(p)
+    p.set_defaults(func=run_plan)
 
 
 #: exit status after Ctrl-C, as a shell reports a process ended by SIGINT (128 + 2)

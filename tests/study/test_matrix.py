@@ -102,11 +102,15 @@ def _floats(obj):
 # ----------------------------------------------------------------------------- run ids and scenes
 def test_every_run_is_a_valid_scene_named_by_its_id(config, runs):
     sizes = {matrix.fmt(h): float(h) for h in config["mpm"]["particle_sizes_um"]}
+    relative = config["mpm"].get("ladder") == "relative"
     assert runs
     for rid, d in runs.items():
         scene = Scene.from_dict(d)
         assert scene.name == rid == d["name"]
         suffix = re.fullmatch(r".+_h([0-9.e+-]+)", rid).group(1)
+        if relative:  # a size of the config's times a power of two, so that the two ladders share runs
+            assert any(math.log2(float(suffix) / h).is_integer() for h in sizes.values()), rid
+            sizes[suffix] = float(suffix)
         assert suffix in sizes, rid
         assert scene.discretisation.particle_size_m == pytest.approx(sizes[suffix] * 1e-6, rel=1e-12), rid
         # the dict is complete: it survives the round trip through the Scene unchanged
@@ -154,6 +158,9 @@ def test_shared_figures_share_runs(config):
 def test_sweep_points_at_every_size_pictures_at_the_finest(config):
     sizes = matrix.particle_sizes_um(config)
     assert list(sizes) == sorted((float(h) for h in config["mpm"]["particle_sizes_um"]), reverse=True)
+    if config["mpm"].get("ladder") == "relative":  # each point's own sizes: tests/study/test_ladder.py
+        config = copy.deepcopy(config)
+        config["mpm"]["ladder"] = "paper"
     finest = matrix.fmt(min(float(h) for h in config["mpm"]["particle_sizes_um"]))
     for fig in matrix.SINGLE_RUN_FIGURES:
         ids = matrix.figure_runs(config, fig)
@@ -376,14 +383,18 @@ def test_grid_headroom_reaches_every_scene_of_the_matrix(config, mode):
 
 
 def test_preview_config_is_the_full_matrix_at_two_coarser_sizes():
-    """config/preview.yaml differs from config/config.yaml only in the particle sizes (so it follows the full
-    matrix as that changes), and its h = 10 um runs are the full config's own scenes: one result file serves both."""
+    """config/preview.yaml differs from config/config.yaml only in the particle sizes and the ladder (the same
+    two sizes for every point; so it follows the full matrix as that changes), and its runs at a size a point's
+    ladder in the full config has are the full config's own scenes: one result file serves both."""
     full, preview = CONFIGS["config"], CONFIGS["preview"]
     assert matrix.particle_sizes_um(preview) == (20.0, 10.0)
+    assert preview["mpm"]["ladder"] == "paper"
     same = copy.deepcopy(preview)
-    same["mpm"]["particle_sizes_um"] = full["mpm"]["particle_sizes_um"]
+    for key in ("particle_sizes_um", "ladder", "ladder_targets"):
+        same["mpm"][key] = full["mpm"][key]
     assert same == full
     runs_full, runs_preview = matrix.all_runs(full), matrix.all_runs(preview)
-    at_10 = {rid: scene for rid, scene in runs_preview.items() if rid.endswith("_h10")}
-    assert len(at_10) == len(runs_preview) // 2 == len(runs_full) // 3
-    assert all(runs_full[rid] == scene for rid, scene in at_10.items())
+    shared = set(runs_full) & set(runs_preview)
+    ladders = [matrix.point_ladder(full, p).sizes_um for p in matrix.all_points(full).values()]
+    assert len(shared) == sum((20.0 in s) + (10.0 in s) for s in ladders) > len(runs_preview) // 2
+    assert all(runs_full[rid] == runs_preview[rid] for rid in shared)

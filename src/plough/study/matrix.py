@@ -33,6 +33,7 @@ from plough.mpm.scene import (
     Scene,
     Sliding,
     Sphere,
+    expected_contact,
     material_from_spec,
     sized_domain,
 )
@@ -47,6 +48,11 @@ MPM_FIGURES = tuple(sorted(SWEEP_FIGURES + SINGLE_RUN_FIGURES))
 #: ``mpm.finest_failure``: what a finest sweep run that stops unstable leaves (README, "Rebuild one figure")
 FINEST_FAILURE_CHOICES = ("record", "stop")
 FINEST_FAILURE_DEFAULT = "record"
+#: ``mpm.ladder``: the particle sizes of each MPM point (``point_ladder``; docs/workflow.md, "The ladder")
+LADDER_CHOICES = ("paper", "relative")
+LADDER_DEFAULT = "paper"
+#: ``mpm.ladder_targets`` of the relative ladder: particles across each length at a point's finest size
+LADDER_TARGETS = ("contact_radius_particles", "groove_depth_particles", "coating_particles")
 
 AXES = {
     "hardness_ratio": ("1", "coating to substrate hardness ratio H~ = Hc / Hs"),
@@ -333,7 +339,80 @@ def figure_points(config: dict[str, Any], figure: str) -> dict[str, Point]:
 
 
 def particle_sizes_um(config: dict[str, Any]) -> tuple[float, ...]:
+    """The config's particle sizes ``mpm.particle_sizes_um``, descending: the paper's ladder, which every
+    point runs with ``mpm.ladder: paper`` and which the relative ladder scales by a power of two per point
+    (:func:`point_ladder`). A point's own sizes: ``point_ladder(config, point).sizes_um``."""
     return tuple(sorted((float(h) for h in config["mpm"]["particle_sizes_um"]), reverse=True))
+
+
+@dataclass(frozen=True)
+class Ladder:
+    """The particle sizes of one point (descending, um) and the length scales they were chosen from (um)."""
+
+    sizes_um: tuple[float, ...]
+    #: sizes_um = the config's particle_sizes_um x scale; scale = 2^k (1 for the paper's ladder)
+    scale: float
+    contact_radius_um: float  # the analytical model's expected contact radius a
+    groove_depth_um: float  # its ploughing depth dp
+    coating_um: float  # the coating thickness t (0: uncoated)
+    #: the target that set the finest size (a key of LADDER_TARGETS), or "paper"
+    set_by: str
+
+    @property
+    def finest_um(self) -> float:
+        return self.sizes_um[-1]
+
+    def particles(self) -> dict[str, float | None]:
+        """Particles across each length at the finest size (a / h, dp / h, t / h; None for t uncoated)."""
+        h = self.finest_um
+        return {"contact_radius_particles": self.contact_radius_um / h,
+                "groove_depth_particles": self.groove_depth_um / h,
+                "coating_particles": self.coating_um / h if self.coating_um > 0 else None}
+
+
+def _exponent(length_um: float, target: float, finest_um: float) -> int:
+    """The largest k with ``length / (finest 2^k) >= target`` (round-off in favour of the target)."""
+    return math.floor(math.log2(length_um / (target * finest_um)) + 1e-9)
+
+
+def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
+    """The particle sizes of ``point``: ``mpm.ladder: paper`` (the default) runs every point at the config's
+    ``particle_sizes_um``; ``relative`` runs it at those sizes times 2^k, k the largest integer at which the
+    finest size holds ``mpm.ladder_targets`` particles across the point's own lengths:
+
+    * ``contact_radius_particles`` across the expected contact radius a (``plough.mpm.scene.expected_contact``,
+      the analytical model): the contact patch and the plastic zone under it, which set mu; it may take the
+      point below the config's finest size (k < 0);
+    * ``groove_depth_particles`` across the expected ploughing depth dp: the groove and its rims (dp);
+    * ``coating_particles`` across the coating thickness t (coated points): the coating's own flow, which
+      sets the layered system's hardness.
+
+    The groove and coating targets never take a point below the config's finest size (k >= 0 for them):
+    where the paper's own ladder leaves a groove or a thin coating under a particle, so does this one.
+    ``null`` leaves a target out. Sizes are the config's times a power of two, so a run shared by both
+    ladders is one run (its id names its size)."""
+    mpm = config["mpm"]
+    paper = particle_sizes_um(config)
+    choice = mpm.get("ladder", LADDER_DEFAULT)
+    if choice not in LADDER_CHOICES:
+        raise ValueError(f"mpm.ladder = {choice!r} is unknown; allowed: {', '.join(LADDER_CHOICES)}")
+    a_m, dp_m = expected_contact(point.layers(), point.load_N, point.radius_m)
+    a, dp, t = a_m * 1e6, dp_m * 1e6, point.thickness_m * 1e6
+    if choice == "paper":
+        return Ladder(paper, 1.0, a, dp, t, "paper")
+    targets = mpm.get("ladder_targets")
+    if not isinstance(targets, dict) or targets.get("contact_radius_particles") is None:
+        raise ValueError("mpm.ladder = relative needs mpm.ladder_targets with contact_radius_particles (> 0); "
+                         f"optional: {', '.join(LADDER_TARGETS[1:])} (null: not a target)")
+    finest = paper[-1]
+    bounds = {"contact_radius_particles": _exponent(a, float(targets["contact_radius_particles"]), finest)}
+    if targets.get("groove_depth_particles") is not None:
+        bounds["groove_depth_particles"] = max(0, _exponent(dp, float(targets["groove_depth_particles"]), finest))
+    if targets.get("coating_particles") is not None and t > 0:
+        bounds["coating_particles"] = max(0, _exponent(t, float(targets["coating_particles"]), finest))
+    set_by = min(bounds, key=lambda name: bounds[name])  # the first of equals: the contact before the others
+    scale = 2.0 ** bounds[set_by]
+    return Ladder(tuple(h * scale for h in paper), scale, a, dp, t, set_by)
 
 
 def run_id(point: Point, h_um: float) -> str:
@@ -341,17 +420,27 @@ def run_id(point: Point, h_um: float) -> str:
 
 
 def figure_runs(config: dict[str, Any], figure: str) -> list[str]:
-    """Run ids a figure needs: every size of every sweep point, the finest size for pictures."""
+    """Run ids a figure needs: every size of every sweep point, the finest size for pictures (each point's
+    own sizes: :func:`point_ladder`)."""
     if figure in SINGLE_RUN_FIGURES:
-        h = particle_sizes_um(config)[-1]
-        return [run_id(p, h) for p in figure_points(config, figure).values()]
+        return [run_id(p, point_ladder(config, p).finest_um) for p in figure_points(config, figure).values()]
     if figure == "fig22":  # the MPM points of Fig. 21 beside the power-law fits
         return figure_runs(config, "fig21")
     if figure not in SWEEP_FIGURES:
         return []
     ids = (run_id(p, h) for panel in figure_panels(config, figure) for s in panel.series for p in s.points
-           for h in particle_sizes_um(config))
+           for h in point_ladder(config, p).sizes_um)
     return list(dict.fromkeys(ids))  # a run shared by two panels is listed once
+
+
+def coarser_sizes_um(config: dict[str, Any], finest_run: str) -> list[float]:
+    """The sizes (um, coarsest first) of the two runs that may stand in for a finest sweep run
+    (:func:`finest_sweep_runs`): its point's own ladder's next two sizes."""
+    for p in all_points(config, SWEEP_FIGURES).values():
+        sizes = point_ladder(config, p).sizes_um
+        if len(sizes) >= 3 and run_id(p, sizes[-1]) == finest_run:
+            return [sizes[-3], sizes[-2]]
+    raise ValueError(f"run {finest_run!r} is not the finest run of a sweep point with three sizes or more")
 
 
 # ----------------------------------------------------------------------------- scenes
@@ -427,7 +516,7 @@ def all_runs(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> 
     wanted = {rid for fig in figures for rid in figure_runs(config, fig)}
     runs: dict[str, dict[str, Any]] = {}
     for p in points.values():
-        for h in particle_sizes_um(config):
+        for h in point_ladder(config, p).sizes_um:
             rid = run_id(p, h)
             if rid in wanted:
                 try:
@@ -462,12 +551,12 @@ def finest_sweep_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
     """finest-size run id -> (coarsest, middle) run ids of the same point, for every sweep point
     whose value two coarser sizes could stand in for: empty with fewer than three sizes; never a run
     a picture (single-run figure) needs."""
-    sizes = particle_sizes_um(config)
-    if len(sizes) < 3:
+    if len(particle_sizes_um(config)) < 3:
         return {}
     pictures = {rid for fig in SINGLE_RUN_FIGURES for rid in figure_runs(config, fig)}
     out = {}
     for p in all_points(config, SWEEP_FIGURES).values():
+        sizes = point_ladder(config, p).sizes_um
         finest = run_id(p, sizes[-1])
         if finest not in pictures:
             out[finest] = (run_id(p, sizes[-3]), run_id(p, sizes[-2]))

@@ -1,0 +1,369 @@
+"""The plan before the run: ``plough plan`` projects the wall time of a workflow config, per figure and in
+total, on this machine and per cluster job, before anything runs.
+
+    plough plan [--configfile FILE ...] [--cores 2] [--profile profiles/slurm] [--points]
+
+The config is read as Snakemake reads it: ``config/config.yaml``, then each ``--configfile`` merged into it
+key by key. Each MPM run's particle-steps are counted by :func:`plough.study.cost.estimate` (within a few
+per cent of the solver's), and its time is its particle-steps over the throughput *measured* for workflow
+jobs of its family (rigid-plastic or real materials, whose flow laws cost more) at the measured particle
+size nearest in log h: the sum of the measured jobs' wall times over the sum of their particle-steps, so
+a job's start-up, its result's writing and the fixed cost of a step are in it. The measured jobs are
+
+* the workflow's own benchmark files of the runs of this config, ``benchmarks/runs/<run>.tsv`` (Snakemake's
+  ``benchmark:``, column ``s``) beside a result file that is a run (not a skip or failure marker), its
+  threads read from the result (``cost_threads``); and
+* the rows of ``benchmarks/results/projection_check_*.json`` (``benchmarks/projection_check.py``: workflow
+  runs measured here, at the threads of the config each names), where no benchmark file of the same run
+  is present.
+
+Jobs measured at other thread counts are scaled linearly (optimistic: the scaling is not linear). With no
+measured job of a family, its runs go at :data:`plough.study.cost.THROUGHPUT_PER_THREAD` a thread, the
+slowest rate measured for workflow jobs here. On a cluster each run is one job with the profile's threads
+(``set-threads: mpm_run``), its time scaled linearly from the time here, and its request the profile's
+(:func:`plough.study.cost.runtime_minutes`). What this leaves out: the analytical figures and the datasets
+(seconds each), the machine's drift (whole-run times vary by up to 30% between invocations,
+docs/performance.md), and a finest run that is skipped or stops (counted in full).
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+#: where the measured calibration lives, relative to the working directory (the repository root)
+CALIBRATION_FILES = "benchmarks/results/projection_check_*.json"
+RUN_BENCHMARKS = "benchmarks/runs"
+BASE_CONFIG = "config/config.yaml"
+FAMILIES = ("rigid-plastic", "real materials")
+#: every figure the workflow draws; the analytical ones (and Fig. 22's fits) need no MPM run of their own
+ALL_FIGURES = ("fig03", "fig04", "fig11", "fig12", "fig13", "fig14", "fig15", "fig16", "fig17", "fig18", "fig19",
+               "fig20", "fig21", "fig22", "fig23")
+
+
+def merge(base: dict[str, Any], override: Mapping[str, Any]) -> dict[str, Any]:
+    """``override`` merged into ``base`` key by key, as Snakemake merges a ``--configfile`` (in place)."""
+    for key, value in override.items():
+        if isinstance(value, Mapping):
+            base[key] = merge(base.get(key) if isinstance(base.get(key), dict) else {}, value)
+        else:
+            base[key] = value
+    return base
+
+
+def load_config(configfiles: Iterable[str | Path], directory: str | Path = ".") -> dict[str, Any]:
+    """The workflow's config: ``config/config.yaml`` of ``directory``, then each file merged into it."""
+    import yaml
+
+    config: dict[str, Any] = yaml.safe_load((Path(directory) / BASE_CONFIG).read_text())
+    for f in configfiles:
+        path = Path(f) if Path(f).is_absolute() or Path(f).exists() else Path(directory) / f
+        merge(config, yaml.safe_load(path.read_text()) or {})
+    return config
+
+
+@dataclass(frozen=True)
+class Measured:
+    """One measured workflow job: its run, family, size, counted particle-steps, wall time and threads."""
+
+    run: str
+    family: str
+    h_um: float
+    particle_steps: float
+    seconds: float
+    threads: int
+    source: str
+
+
+def family_of(scene: Any) -> str:
+    """``real materials`` for a run whose layers use the real flow laws, else ``rigid-plastic``."""
+    from plough.materials import ConstantFlow
+
+    constant = all(isinstance(m.flow, ConstantFlow) for m in scene.layers.materials)
+    return "rigid-plastic" if constant else "real materials"
+
+
+def measured_from_json(paths: Iterable[Path]) -> list[Measured]:
+    """The rows of ``projection_check.py`` results, at the threads of the config each names (2 if unknown)."""
+    import yaml
+
+    rows = []
+    for path in sorted(paths):
+        data = json.loads(path.read_text())
+        threads = 2
+        named = data.get("config")
+        for candidate in (Path(named), path.parents[2] / named) if named else ():
+            if candidate.exists():
+                threads = int(yaml.safe_load(candidate.read_text())["mpm"]["threads"])
+                break
+        for r in data["runs"]:
+            if math.isfinite(r.get("measured_s", math.nan)) and r["measured_s"] > 0:
+                rows.append(Measured(r["run"], r["family"], float(r["h_um"]), float(r["particle_steps"]),
+                                     float(r["measured_s"]), threads, str(path)))
+    return rows
+
+
+def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: int) -> list[Measured]:
+    """The workflow's benchmark files of ``runs`` (run id -> scene) under ``directory``: each with a result
+    file that is a run; a skip or failure marker's job made no run. Threads from the result
+    (``cost_threads``), else ``threads``."""
+    import xarray as xr
+
+    from plough.study import cost
+
+    rows = []
+    for tsv in sorted((directory / RUN_BENCHMARKS).glob("*.tsv")):
+        rid = tsv.stem
+        result = directory / "results" / "runs" / f"{rid}.nc"
+        if rid not in runs or not result.exists():
+            continue
+        try:
+            with xr.open_dataset(result) as ds:
+                attrs = dict(ds.attrs)
+        except (OSError, ValueError):
+            continue
+        if attrs.get("skipped_finest_size") or attrs.get("failed_finest_size") or "cost_particle_steps" not in attrs:
+            continue
+        with tsv.open() as f:
+            seconds = float(next(csv.DictReader(f, delimiter="\t"))["s"])
+        scene = runs[rid]
+        rows.append(Measured(rid, family_of(scene), round(scene.discretisation.particle_size_m * 1e6, 6),
+                             cost.estimate(scene).particle_steps, seconds, int(attrs.get("cost_threads", threads)),
+                             str(tsv)))
+    return rows
+
+
+@dataclass(frozen=True)
+class Rates:
+    """Particle-steps per second of a job at ``threads`` threads, by family and measured size."""
+
+    threads: int
+    by_family: dict[str, dict[float, tuple[int, float]]]  # family -> h (um) -> (jobs, particle-steps / s)
+
+    @classmethod
+    def from_measured(cls, rows: Iterable[Measured], threads: int) -> Rates:
+        """Sum of particle-steps over the sum of wall times (each scaled linearly to ``threads``) per family and
+        size; a run measured twice counts once, its last row."""
+        last = {r.run: r for r in rows}
+        sums: dict[str, dict[float, list[float]]] = {}
+        for r in last.values():
+            acc = sums.setdefault(r.family, {}).setdefault(r.h_um, [0, 0.0, 0.0])
+            acc[0] += 1
+            acc[1] += r.particle_steps
+            acc[2] += r.seconds * r.threads / threads
+        return cls(threads, {fam: {h: (int(a[0]), a[1] / a[2]) for h, a in by_h.items()}
+                             for fam, by_h in sums.items()})
+
+    def rate(self, family: str, h_um: float) -> float:
+        """The family's rate at the measured size nearest in log h (the smaller of two as near, as
+        benchmarks/reproduction_time.py calibrates); with none measured, ``cost.THROUGHPUT_PER_THREAD`` a thread."""
+        from plough.study import cost
+
+        by_h = self.by_family.get(family)
+        if not by_h:
+            return cost.THROUGHPUT_PER_THREAD * self.threads
+        return by_h[min(by_h, key=lambda h: (abs(math.log(h / h_um)), h))][1]
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    run: str
+    family: str
+    h_um: float
+    particle_steps: float
+    memory_mb: int
+    here_s: float  # one job here, at the config's threads
+    cluster_s: float  # one job at the profile's threads (linear scaling)
+    request_min: int  # the profile's wall-time request (plough.study.cost.runtime_minutes)
+
+
+@dataclass(frozen=True)
+class Plan:
+    config: dict[str, Any]
+    threads: int
+    cores: int
+    cluster_threads: int
+    rates: Rates
+    measured: list[Measured]
+    runs: dict[str, RunPlan]
+    figures: dict[str, list[str]]
+
+    @property
+    def parallel_jobs(self) -> int:
+        return max(1, self.cores // self.threads)
+
+    def wall_s(self, runs: Iterable[str]) -> float:
+        """Wall time here of these runs, ``parallel_jobs`` at a time: their sum over the jobs at once, or the
+        longest run if longer."""
+        times = [self.runs[r].here_s for r in runs]
+        return max(sum(times) / self.parallel_jobs, max(times, default=0.0))
+
+
+def cluster_threads(profile: str | Path | None) -> int | None:
+    """``set-threads: mpm_run`` of a Snakemake profile directory (None without one)."""
+    import yaml
+
+    if profile is None:
+        return None
+    path = Path(profile) / "config.yaml"
+    if not path.exists():
+        return None
+    data = yaml.safe_load(path.read_text()) or {}
+    threads = (data.get("set-threads") or {}).get("mpm_run")
+    return int(threads) if threads is not None else None
+
+
+def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path = ".",
+              calibration: Iterable[str | Path] | None = None, cluster: int = 8) -> Plan:
+    """Project every MPM run of ``config``. ``calibration``: projection_check result files (default: those
+    under ``directory``); the workflow's benchmark files under ``directory`` are read too."""
+    from plough.mpm.scene import Scene
+    from plough.study import cost, matrix
+
+    directory = Path(directory)
+    threads = int(config["mpm"]["threads"])
+    scenes = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(config).items()}
+    files = [Path(f) for f in calibration] if calibration is not None else sorted(directory.glob(CALIBRATION_FILES))
+    measured = measured_from_json(files) + measured_from_benchmarks(directory, scenes, threads)
+    rates = Rates.from_measured(measured, threads)
+    runs = {}
+    for rid, scene in scenes.items():
+        c = cost.estimate(scene)
+        family = family_of(scene)
+        h = round(scene.discretisation.particle_size_m * 1e6, 6)
+        here = c.particle_steps / rates.rate(family, h)
+        runs[rid] = RunPlan(rid, family, h, c.particle_steps, c.memory_mb, here, here * threads / cluster,
+                            cost.runtime_minutes(c, cluster))
+    figures = {fig: [r for r in matrix.figure_runs(config, fig) if r in runs] for fig in ALL_FIGURES}
+    return Plan(config, threads, cores, cluster, rates, measured, runs, figures)
+
+
+def _hours(seconds: float) -> str:
+    if seconds < 90:
+        return f"{seconds:.0f} s"
+    if seconds < 5400:
+        return f"{seconds / 60:.0f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def describe(plan: Plan, *, points: bool = False) -> str:
+    """The plan as text: the ladder, the calibration, a table per figure and the totals, the cluster."""
+    from plough.study import matrix
+
+    mpm = plan.config["mpm"]
+    ladder = mpm.get("ladder", matrix.LADDER_DEFAULT)
+    lines = []
+    sizes = ", ".join(f"{h:g}" for h in matrix.particle_sizes_um(plan.config))
+    if ladder == "relative":
+        targets = ", ".join(f"{k} {v:g}" for k, v in mpm["ladder_targets"].items() if v is not None)
+        lines.append(f"ladder: relative (each point's sizes: {sizes} um times a power of two; targets at its finest "
+                     f"size: {targets})")
+    else:
+        lines.append(f"ladder: paper ({sizes} um for every point)")
+    sources = sorted({r.source for r in plan.measured})
+    lines.append(f"calibration: {len({r.run for r in plan.measured})} measured workflow jobs"
+                 + (f" ({'; '.join(_short(s) for s in _sources(sources))})" if sources else ""))
+    for fam in FAMILIES:
+        by_h = plan.rates.by_family.get(fam)
+        if by_h:
+            text = ", ".join(f"h = {h:g} um {rate / 1e6:.2f} M/s ({n} jobs)" for h, (n, rate) in sorted(by_h.items()))
+        else:
+            text = f"none measured: {plan.rates.rate(fam, 1.0) / 1e6:.2f} M/s (plough.study.cost.THROUGHPUT_PER_THREAD)"
+        lines.append(f"  {fam}, particle-steps per second of a job at {plan.threads} threads: {text}")
+    lines.append("")
+    lines.append(f"| figure | MPM runs | particle-steps | here (--cores {plan.cores}, {plan.threads} threads a run) | "
+                 f"longest job here | longest job on the cluster ({plan.cluster_threads} threads) |")
+    lines.append("|---|---|---|---|---|---|")
+    for fig, rids in plan.figures.items():
+        if not rids:
+            lines.append(f"| {fig} | 0 | | seconds (analytical) | | |")
+            continue
+        longest = max(rids, key=lambda r: plan.runs[r].here_s)
+        lines.append(f"| {fig} | {len(rids)} | {sum(plan.runs[r].particle_steps for r in rids):.3g} | "
+                     f"{_hours(plan.wall_s(rids))} | {_hours(plan.runs[longest].here_s)} | "
+                     f"{_hours(plan.runs[longest].cluster_s)} |")
+    every = list(plan.runs)
+    total_ps = sum(r.particle_steps for r in plan.runs.values())
+    longest = max(plan.runs.values(), key=lambda r: r.here_s, default=None)
+    lines.append(f"| **all** (each run once) | {len(every)} | {total_ps:.3g} | **{_hours(plan.wall_s(every))}** | "
+                 f"{_hours(longest.here_s) if longest else ''} | {_hours(longest.cluster_s) if longest else ''} |")
+    lines.append("")
+    for fam in FAMILIES:
+        fam_runs = [r for r in plan.runs.values() if r.family == fam]
+        if fam_runs:
+            lines.append(f"{fam}: {len(fam_runs)} runs, {sum(r.particle_steps for r in fam_runs):.3g} particle-steps, "
+                         f"{_hours(sum(r.here_s for r in fam_runs))} of jobs here")
+    by_size: dict[float, list[RunPlan]] = {}
+    for r in plan.runs.values():
+        by_size.setdefault(r.h_um, []).append(r)
+    lines.append("by particle size: " + "; ".join(
+        f"h = {h:g} um: {len(rs)} runs, {sum(r.particle_steps for r in rs):.3g} particle-steps, "
+        f"{_hours(sum(r.here_s for r in rs))}" for h, rs in sorted(by_size.items(), reverse=True)))
+    if longest is not None:
+        core_h = sum(r.cluster_s for r in plan.runs.values()) * plan.cluster_threads / 3600
+        requested = sum(r.request_min for r in plan.runs.values()) * plan.cluster_threads / 60
+        biggest = max(plan.runs.values(), key=lambda r: r.memory_mb)
+        lines.append(f"on a cluster, one job a run at {plan.cluster_threads} threads: {len(every)} jobs, the longest "
+                     f"{longest.run} {_hours(longest.cluster_s)} (scaled linearly from here; its request "
+                     f"{longest.request_min} min); {core_h:.0f} core-hours projected, {requested:.0f} core-hours "
+                     f"requested; the largest memory request {biggest.memory_mb / 1000:.1f} GB ({biggest.run})")
+    if points:
+        lines.append("")
+        lines.append("| point | sizes (um) | set by | a / h | dp / h | t / h | here |")
+        lines.append("|---|---|---|---|---|---|---|")
+        for p in matrix.all_points(plan.config).values():
+            lad = matrix.point_ladder(plan.config, p)
+            q = lad.particles()
+            rids = [matrix.run_id(p, h) for h in lad.sizes_um if matrix.run_id(p, h) in plan.runs]
+            t = q["coating_particles"]
+            lines.append(f"| {p.key} | {', '.join(f'{h:g}' for h in lad.sizes_um)} | {lad.set_by} | "
+                         f"{q['contact_radius_particles']:.1f} | {q['groove_depth_particles']:.2f} | "
+                         f"{'' if t is None else f'{t:.2f}'} | {_hours(sum(plan.runs[r].here_s for r in rids))} |")
+    return "\n".join(lines)
+
+
+def _sources(sources: list[str]) -> list[str]:
+    """The calibration files, and the benchmark files as one entry (their folder)."""
+    files = [s for s in sources if not s.endswith(".tsv")]
+    tsv = [s for s in sources if s.endswith(".tsv")]
+    return files + ([f"{len(tsv)} files in {Path(tsv[0]).parent}"] if tsv else [])
+
+
+def _short(path: str) -> str:
+    try:
+        return str(Path(path).resolve().relative_to(Path.cwd().resolve()))
+    except ValueError:
+        return path
+
+
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--configfile", nargs="+", default=[], metavar="FILE",
+                   help="config files merged into config/config.yaml key by key, as snakemake's --configfile")
+    p.add_argument("--cores", type=int, default=2, help="cores snakemake is given here (default 2)")
+    p.add_argument("--directory", default=".", help="the workflow's directory (default: the current one)")
+    p.add_argument("--profile", default="profiles/slurm",
+                   help="the cluster profile whose set-threads: mpm_run gives a job's threads (default "
+                   "profiles/slurm; 8 if it has none)")
+    p.add_argument("--calibration", nargs="*", default=None, metavar="FILE",
+                   help=f"projection_check.py results to calibrate with (default: {CALIBRATION_FILES})")
+    p.add_argument("--points", action="store_true", help="also each point's sizes and resolution")
+
+
+def run_plan(args: argparse.Namespace) -> int:
+    if args.cores < 1:
+        raise ValueError(f"--cores = {args.cores} must be >= 1")
+    directory = Path(args.directory)
+    config = load_config(args.configfile, directory)
+    profile = Path(args.profile) if Path(args.profile).is_absolute() else directory / args.profile
+    threads = cluster_threads(profile) or 8
+    plan = make_plan(config, cores=args.cores, directory=directory, calibration=args.calibration, cluster=threads)
+    names = ", ".join([BASE_CONFIG, *args.configfile])
+    print(f"plough plan: {names}; {len(plan.runs)} MPM runs; projected before anything runs")
+    print(describe(plan, points=args.points))
+    return 0

@@ -1,0 +1,164 @@
+"""The particle sizes of each MPM point (plough.study.matrix.point_ladder): the paper's ladder and the relative one.
+
+The relative ladder's sizes are checked against the targets directly (the expected contact radius and groove
+depth of the analytical model, the coating thickness), and the default config against issue 34's budget.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from pathlib import Path
+
+import jsonschema
+import pytest
+import yaml
+
+from plough.mpm.scene import Scene, expected_contact
+from plough.study import cost, matrix
+
+ROOT = Path(__file__).resolve().parents[2]
+SCHEMA = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+
+
+def _load(name: str) -> dict:
+    return yaml.safe_load((ROOT / "config" / f"{name}.yaml").read_text())
+
+
+CONFIG = _load("config")
+
+
+def _relative(targets: dict) -> dict:
+    config = copy.deepcopy(CONFIG)
+    config["mpm"]["ladder"] = "relative"
+    config["mpm"]["ladder_targets"] = targets
+    return config
+
+
+def _lengths_um(point: matrix.Point) -> tuple[float, float, float]:
+    a, dp = expected_contact(point.layers(), point.load_N, point.radius_m)
+    return a * 1e6, dp * 1e6, point.thickness_m * 1e6
+
+
+def test_the_paper_ladder_runs_every_point_at_the_configs_sizes():
+    paper = _load("paper")
+    assert paper["mpm"]["ladder"] == "paper" and paper["mpm"]["skip_finest_tolerance"] is None
+    sizes = tuple(sorted((float(h) for h in paper["mpm"]["particle_sizes_um"]), reverse=True))
+    assert sizes == (10.0, 5.0, 2.5)
+    for p in matrix.all_points(paper).values():
+        lad = matrix.point_ladder(paper, p)
+        assert lad.sizes_um == sizes and lad.scale == 1.0 and lad.set_by == "paper"
+    # without the key: the paper's ladder (the preview and smoke configs set it, as a merge over config.yaml needs)
+    plain = copy.deepcopy(paper)
+    del plain["mpm"]["ladder"]
+    assert matrix.all_runs(plain) == matrix.all_runs(paper)
+    for name in ("preview", "smoke"):
+        assert _load(name)["mpm"]["ladder"] == "paper"
+
+
+def test_paper_yaml_is_config_yaml_with_the_papers_ladder():
+    """config/paper.yaml follows the study matrix of config/config.yaml: only the ladder differs."""
+    paper, same = _load("paper"), copy.deepcopy(CONFIG)
+    same["mpm"]["ladder"] = "paper"
+    del same["mpm"]["ladder_targets"]
+    assert paper == same
+
+
+@pytest.mark.parametrize("targets", [
+    {"contact_radius_particles": 12, "groove_depth_particles": 1, "coating_particles": 1.5},
+    {"contact_radius_particles": 9, "groove_depth_particles": None, "coating_particles": None},
+    {"contact_radius_particles": 20, "groove_depth_particles": 3, "coating_particles": 4},
+])
+def test_the_relative_ladder_is_the_coarsest_that_meets_its_targets(targets):
+    config = _relative(targets)
+    paper = matrix.particle_sizes_um(config)
+    finest_paper = paper[-1]
+    na, nd, nt = (targets[k] for k in matrix.LADDER_TARGETS)
+    for p in matrix.all_points(config).values():
+        lad = matrix.point_ladder(config, p)
+        a, dp, t = _lengths_um(p)
+        assert lad.contact_radius_um == pytest.approx(a) and lad.groove_depth_um == pytest.approx(dp)
+        k = math.log2(lad.scale)
+        assert k.is_integer() and lad.sizes_um == tuple(h * lad.scale for h in paper), p.key
+        h = lad.finest_um
+
+        def meets(size: float, a: float = a, dp: float = dp, t: float = t) -> bool:
+            """The targets at a finest size; groove and coating down to the config's finest size only."""
+            ok = a / size >= na * (1 - 1e-9)
+            if nd is not None and size > finest_paper:
+                ok &= dp / size >= nd * (1 - 1e-9)
+            if nt is not None and t > 0 and size > finest_paper:
+                ok &= t / size >= nt * (1 - 1e-9)
+            return ok
+
+        assert meets(h), (p.key, lad)
+        assert not meets(2 * h), (p.key, lad)  # the coarsest that does
+        if nd is not None and h < finest_paper * (1 - 1e-9):
+            assert dp / h >= nd or lad.set_by == "contact_radius_particles"
+
+
+def test_the_default_config_within_issue_34s_budget_and_resolved_as_the_validated_scene():
+    """config/config.yaml: at most 4e11 particle-steps counted by the cost model (the paper's ladder: 4.16e12),
+    every point's finest contact at least as resolved as the rigid-plastic reference scene the paper validated
+    at h = 5 um (a / h = 9.2), and the coarsest of its three sizes at a >= 3 h."""
+    assert CONFIG["mpm"]["ladder"] == "relative"
+    runs = matrix.all_runs(CONFIG)
+    steps = sum(cost.estimate(Scene.from_dict(s)).particle_steps for s in runs.values())
+    assert steps <= 4e11
+    rp = CONFIG["mpm"]["rigid_plastic"]
+    ts = rp["thickness_sweep"]
+    reference = matrix.rigid_plastic_point(rp, 1.0, ts["soft"]["substrate_hardness_MPa"], 0, ts["interface"], 12.5)
+    validated = _lengths_um(reference)[0] / 5.0
+    assert validated == pytest.approx(9.2, abs=0.05)
+    for p in matrix.all_points(CONFIG).values():
+        lad = matrix.point_ladder(CONFIG, p)
+        assert lad.contact_radius_um / lad.finest_um >= validated, p.key
+        assert lad.contact_radius_um / lad.sizes_um[0] >= 3.0, p.key
+
+
+def test_runs_of_the_two_ladders_at_the_same_size_are_one_run():
+    relative, paper = matrix.all_runs(CONFIG), matrix.all_runs(_load("paper"))
+    shared = set(relative) & set(paper)
+    assert shared  # points whose relative ladder has a paper size
+    assert all(relative[r] == paper[r] for r in shared)
+
+
+def test_finest_sweep_runs_and_their_coarser_sizes_follow_each_point():
+    finest = matrix.finest_sweep_runs(CONFIG)
+    assert len(finest) == 64
+    for rid, (coarse, middle) in finest.items():
+        h_coarse, h_mid = matrix.coarser_sizes_um(CONFIG, rid)
+        h = float(rid.rsplit("_h", 1)[1])
+        assert (h_coarse, h_mid) == (4 * h, 2 * h)
+        assert coarse.endswith(f"_h{matrix.fmt(h_coarse)}") and middle.endswith(f"_h{matrix.fmt(h_mid)}")
+    with pytest.raises(ValueError, match="not the finest run"):
+        matrix.coarser_sizes_um(CONFIG, next(iter(finest.values()))[0])
+
+
+def test_pictures_run_at_their_points_finest_size():
+    for fig in matrix.SINGLE_RUN_FIGURES:
+        for p, rid in zip(matrix.figure_points(CONFIG, fig).values(), matrix.figure_runs(CONFIG, fig), strict=True):
+            assert rid == matrix.run_id(p, matrix.point_ladder(CONFIG, p).finest_um)
+
+
+def test_the_schema_and_the_matrix_refuse_a_bad_ladder():
+    validator = jsonschema.Draft202012Validator(SCHEMA)
+    assert not list(validator.iter_errors(CONFIG))
+    bad = copy.deepcopy(CONFIG)
+    del bad["mpm"]["ladder_targets"]
+    assert any("ladder_targets" in e.message for e in validator.iter_errors(bad))
+    with pytest.raises(ValueError, match="ladder_targets"):
+        matrix.all_runs(bad)
+    for key, value in (("contact_radius_particles", 0), ("groove_depth_particles", -1), ("coating", 1)):
+        bad = copy.deepcopy(CONFIG)
+        bad["mpm"]["ladder_targets"][key] = value
+        assert list(validator.iter_errors(bad)), key
+    bad = copy.deepcopy(CONFIG)
+    bad["mpm"]["ladder"] = "absolute"
+    assert list(validator.iter_errors(bad))
+    with pytest.raises(ValueError, match="mpm.ladder = 'absolute'"):
+        matrix.all_runs(bad)
+    unset = copy.deepcopy(CONFIG)
+    unset["mpm"]["ladder_targets"] = {"contact_radius_particles": 12, "groove_depth_particles": None}
+    assert not list(validator.iter_errors(unset))
+    assert len(matrix.all_runs(unset)) == 201
