@@ -6,6 +6,7 @@ from plough.study.analytical_figures import config_section
 rule analytical_dataset:
     input:
         PACKAGE_SOURCES,
+        str(SCRIPTS / "analytical_dataset.py"),
     output:
         "results/datasets/{figure}.nc",
     params:

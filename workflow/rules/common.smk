@@ -1,12 +1,28 @@
-# Shared definitions: figure lists, the MPM run matrix, and the package source as an input of
-# every rule that runs it (neither the cache key nor the code trigger sees an installed package).
+# Shared definitions: figure lists, the MPM run matrix, what identifies a run, and the package source
+# as an input of the cheap rules (datasets, figures).
+#
+# What reruns what (docs/workflow.md, "Caching, reruns and recovery"): an MPM run reruns when its
+# scene (params) or the solver's fingerprint (params: the hash of plough.mpm and plough.materials
+# without comments and docstrings, plough.fingerprint) changes, never for a file's time: its rule
+# takes no source file as input. The code trigger (a script newer than its outputs) is off
+# (profiles/default, the workflow profile Snakemake reads by itself); the cheap rules take the
+# package source and their script as inputs instead, so an edit still redoes them.
 import re
 from pathlib import Path
 
+from plough.fingerprint import files_fingerprint, solver_fingerprint
 from plough.mpm.scene import Scene
 from plough.study import cost, matrix
+from plough.study.runfiles import figure_view
 
 PACKAGE_SOURCES = sorted(str(p) for p in Path(workflow.basedir, "src", "plough").rglob("*.py"))
+SCRIPTS = Path(workflow.basedir, "workflow", "scripts")
+# the solver the jobs import (the installed plough), and the run job's own code without comments
+SOLVER_FINGERPRINT = solver_fingerprint()
+RUN_SCRIPT_FINGERPRINT = files_fingerprint([SCRIPTS / "mpm_run.py"], SCRIPTS)
+# a skippable run's decision (plough.study.skipping) reads the two coarser runs' extrapolation
+SKIP_DECISION_FINGERPRINT = files_fingerprint(
+    [Path(matrix.__file__).with_name(n) for n in ("skipping.py", "extrapolation.py")], Path(matrix.__file__).parent)
 
 # Fig. 22 shows the power-law fits with the MPM points of Fig. 21: its dataset needs MPM runs.
 ANALYTICAL_FIGURES = ["fig03", "fig04"]

@@ -5,6 +5,7 @@ rule figure:
     input:
         "results/datasets/{figure}.nc",
         PACKAGE_SOURCES,
+        str(SCRIPTS / "plot_figure.py"),
     output:
         png=report("results/figures/{figure}.png", caption="../report/figure.rst", category="Figures"),
         pdf="results/figures/{figure}.pdf",

@@ -26,6 +26,7 @@ from plough.io import provenance_attrs
 from plough.mpm.io import STANDARD_ERROR_META, STEADINESS_META, STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import extrapolate_dataarray, sampling_error
+from plough.study.runfiles import load_run
 from plough.study.skipping import is_failed, is_skipped
 
 TITLES = {
@@ -53,13 +54,17 @@ SINGLE_RUN_VARIABLES = {
 }
 
 
-def load_runs(run_ids: list[str], paths: Mapping[str, str | Path]) -> dict[str, xr.Dataset]:
-    """Load the result file of every run; a missing run is an error naming it (never an empty plot)."""
+def load_runs(run_ids: list[str], paths: Mapping[str, str | Path], scenes: Mapping[str, dict[str, Any]] | None = None,
+              solver: str | None = None) -> dict[str, xr.Dataset]:
+    """Load the result file of every run, each checked against the run it stands for
+    (:func:`plough.study.runfiles.load_run`: its scene, ``scenes[run]`` if given, and the solver
+    fingerprint ``solver`` if given); a missing, unreadable or wrong file is an error naming it
+    (never an empty plot, never another run's numbers)."""
     out = {}
     for rid in run_ids:
-        if rid not in paths or not Path(paths[rid]).exists():
-            raise FileNotFoundError(f"the result of run {rid!r} is missing ({paths.get(rid)}); run it first")
-        out[rid] = xr.load_dataset(paths[rid])
+        if rid not in paths:
+            raise FileNotFoundError(f"the result of run {rid!r} is missing (no file given); run it first")
+        out[rid] = load_run(paths[rid], rid, None if scenes is None else scenes[rid], solver)
     return out
 
 
@@ -257,9 +262,15 @@ def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset]) -> 
     }, coords=coords)
 
 
-def build_dataset(config: dict[str, Any], figure: str, paths: Mapping[str, str | Path]) -> xr.Dataset:
-    """The dataset of one MPM figure from its run result files (run id -> path)."""
-    runs = load_runs(matrix.figure_runs(config, figure), paths)
+def build_dataset(config: dict[str, Any], figure: str, paths: Mapping[str, str | Path],
+                  solver: str | None = None) -> xr.Dataset:
+    """The dataset of one MPM figure from its run result files (run id -> path). Each file must hold
+    its run's scene as the config makes it and, when ``solver`` is given (the workflow gives the
+    current :func:`plough.fingerprint.solver_fingerprint`), have been made by that solver."""
+    if figure != "fig22" and figure not in matrix.MPM_FIGURES:
+        raise ValueError(f"figure = {figure!r} is not an MPM figure; allowed: {matrix.MPM_FIGURES}")
+    scenes = matrix.all_runs(config, ("fig21",) if figure == "fig22" else (figure,))
+    runs = load_runs(matrix.figure_runs(config, figure), paths, scenes, solver)
     if figure == "fig22":
         from plough.study.analytical_figures import fig22_dataset
 
