@@ -162,3 +162,42 @@ def test_the_schema_and_the_matrix_refuse_a_bad_ladder():
     unset["mpm"]["ladder_targets"] = {"contact_radius_particles": 12, "groove_depth_particles": None}
     assert not list(validator.iter_errors(unset))
     assert len(matrix.all_runs(unset)) == 201
+
+
+# ----------------------------------------------------------------------------- the figure datasets
+def test_figure_datasets_read_each_point_at_its_own_sizes(tmp_path):
+    """The smoke matrix under a relative ladder whose points differ in scale: each sweep point is read at its own
+    sizes (``particle_size_um``) and extrapolated as from them (the fake runs follow f0 + c h^1.5 in their own h,
+    so Richardson recovers f0 only if every value sits at its level); pictures at each case's finest size."""
+    from plough.study.mpm_figures import build_dataset
+    from tests.study.test_mpm_figures import SMOKE, fake_run, is_noisy, limit, signature_of
+
+    config = copy.deepcopy(SMOKE)
+    config["mpm"]["ladder"] = "relative"
+    config["mpm"]["ladder_targets"] = {"contact_radius_particles": 3}
+    runs = matrix.all_runs(config)
+    paths = {}
+    for rid, scene in runs.items():
+        paths[rid] = tmp_path / f"{rid}.nc"
+        fake_run(scene).to_netcdf(paths[rid])
+    scales = set()
+    for fig in ("fig11", "fig15"):
+        ds = build_dataset(config, fig, paths)
+        for panel in matrix.figure_panels(config, fig):
+            suffix = f"_{panel.name}" if fig == "fig11" else ""
+            for series in panel.series:
+                for x, p in zip(panel.values, series.points, strict=True):
+                    lad = matrix.point_ladder(config, p)
+                    scales.add(lad.scale)
+                    sel = {panel.series_dim: series.label, panel.axis: x}
+                    own = ds[f"particle_size_um{suffix}"].sel(sel).values
+                    assert list(own) == list(lad.sizes_um), (fig, p.key)
+                    scene = runs[matrix.run_id(p, lad.finest_um)]
+                    if not is_noisy(scene):
+                        assert float(ds[f"mu_h0{suffix}"].sel(sel)) == pytest.approx(
+                            limit("mu", signature_of(scene)), rel=1e-9), (fig, p.key)
+    assert len(scales) > 1  # the test's points do differ in scale
+    for fig in ("fig12", "fig17"):
+        ds = build_dataset(config, fig, paths)
+        for label, p in matrix.figure_points(config, fig).items():
+            assert ds.attrs[f"particle_size_um_{label}"] == matrix.point_ladder(config, p).finest_um

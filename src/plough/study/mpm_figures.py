@@ -69,7 +69,8 @@ def load_runs(run_ids: list[str], paths: Mapping[str, str | Path], scenes: Mappi
 
 
 def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mapping[str, xr.Dataset],
-                   suffix: str, skippable: Collection[str] = (), recordable: Collection[str] = ()) -> xr.Dataset:
+                   suffix: str, skippable: Collection[str] = (), recordable: Collection[str] = (),
+                   ladders: Mapping[str, tuple[float, ...]] | None = None) -> xr.Dataset:
     """One panel's per-size values and their h -> 0 extrapolation. ``sizes_um`` descending; a run in
     ``skippable`` (``matrix.skippable_runs``) may be a skip marker, one in ``recordable``
     (``matrix.failure_recordable_runs``) a failure marker; any other marker is refused. Either way
@@ -79,11 +80,15 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     coords = {
         panel.series_dim: ((panel.series_dim,), labels, {"long_name": panel.series_dim.replace("_", " ")}),
         panel.axis: ((panel.axis,), np.asarray(panel.values, dtype=float), {"units": ax_units, "long_name": ax_long}),
-        "h": (("h",), np.asarray(sizes_um, dtype=float), {"units": "um", "long_name": "particle size h"}),
+        "h": (("h",), np.asarray(sizes_um, dtype=float), {"units": "um", "long_name": "particle size h", **(
+            {"comment": "the sizes of mpm.particle_sizes_um; each point's own (mpm.ladder: relative) are "
+                        "particle_size_um, these times a power of two: its extrapolation is the same"}
+            if ladders else {})}),
     }
     shape = (len(labels), len(panel.values), len(sizes_um))
     per_size = {o: np.full(shape, np.nan) for o in (*matrix.OUTPUTS, "Fz_mean", "max_particle_penetration")}
     wall = np.full(shape, np.nan)
+    size = np.full(shape, np.nan)  # each run's own particle size (the point's ladder: matrix.point_ladder)
     steady = np.full(shape, np.nan)  # stays NaN for skipped runs and files written before the check
     # sampling errors of each run (plough.mpm.io.standard_errors): NaN where skipped, not estimable, or
     # written before they were
@@ -93,7 +98,9 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
     failed = np.zeros(shape[:2], dtype=bool)
     for i, series in enumerate(panel.series):
         for j, point in enumerate(series.points):
-            for k, h in enumerate(sizes_um):
+            own = ladders[point.key] if ladders else sizes_um
+            for k, h in enumerate(own):
+                size[i, j, k] = h
                 rid = matrix.run_id(point, h)
                 ds = runs[rid]
                 if is_skipped(ds):
@@ -157,6 +164,9 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                                            "allow_missing": 1})
     out[f"wall_time_s{suffix}"] = (dims3, wall, {"units": "s", "long_name": "wall time of the run",
                                                  **({"allow_missing": 1} if two_sizes.any() else {})})
+    if ladders:  # mpm.ladder: relative: each point at its own sizes
+        out[f"particle_size_um{suffix}"] = (dims3, size, {"units": "um", "long_name": "the run's particle size "
+                                                          "(the point's own ladder: h times a power of two)"})
     if np.isfinite(steady).any():  # result files written before the check carry none
         out[f"steady{suffix}"] = (dims3, steady, {"units": "1", "allow_missing": 1,
                                                   "long_name": STEADINESS_META["steady"][1] + " (per run; missing: "
@@ -193,7 +203,12 @@ def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dat
     sizes = matrix.particle_sizes_um(config)
     skippable = set(matrix.skippable_runs(config))
     recordable = set(matrix.failure_recordable_runs(config))
-    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", skippable, recordable)
+    # each point's own sizes (mpm.ladder: relative); the h -> 0 extrapolation runs along the config's sizes,
+    # which a point's are times a power of two: Richardson, the GCI, the least-squares fallback and the sampling
+    # errors' weights depend on the sizes' ratios only, so the values and uncertainties are those of its own
+    ladders = {pt.key: matrix.point_ladder(config, pt).sizes_um for p in panels for s in p.series for pt in s.points}
+    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", skippable, recordable,
+                            ladders if any(lad != sizes for lad in ladders.values()) else None)
              for p in panels]
     ds = xr.merge(parts, combine_attrs="drop_conflicts", join="exact")
     ds.attrs["panels"] = ",".join(p.name for p in panels)
@@ -204,13 +219,13 @@ def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dat
 
 def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
     cases = matrix.figure_points(config, figure)
-    h = matrix.particle_sizes_um(config)[-1]
+    finest = {label: matrix.point_ladder(config, p).finest_um for label, p in cases.items()}
     keep = SINGLE_RUN_VARIABLES[figure]
     # result files from before the steadiness check lack the flag: carry it only when every case has it
-    with_steady = all("steady" in runs[matrix.run_id(p, h)] for p in cases.values())
+    with_steady = all("steady" in runs[matrix.run_id(p, finest[label])] for label, p in cases.items())
     parts = []
     for label, point in cases.items():
-        rid = matrix.run_id(point, h)
+        rid = matrix.run_id(point, finest[label])
         run = runs[rid]
         if is_skipped(run) or is_failed(run):
             reason = run.attrs.get("failure_reason") or run.attrs.get("skip_reason")
@@ -236,7 +251,10 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
             if ds[name].ndim > 1:
                 ds[name].attrs["allow_missing"] = 1  # cases of different size are padded with NaN
     ds["case"].attrs["long_name"] = "case"
-    ds.attrs["particle_size_um"] = h
+    if len(set(finest.values())) == 1:
+        ds.attrs["particle_size_um"] = next(iter(finest.values()))
+    for label, h in finest.items():  # the cases of one figure may differ (each point's own finest size)
+        ds.attrs["particle_size_um_" + label] = h
     return ds
 
 
