@@ -164,7 +164,9 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
                        if any_analytical else []),
                      *([(Line2D([], [], ls="none", color="k", marker="o", ms=MARK_SIZE, mfc="white"),
                          FLAGGED_LABEL)] if any_flagged else []),
-                     (sizes, "faint: per size, h = " + ", ".join(f"{h:g}" for h in h_values) + " µm")]
+                     (sizes, "faint: per size, coarsest to finest (each point's own sizes)"
+                      if f"particle_size_um{suffix}" in ds  # mpm.ladder: relative
+                      else "faint: per size, h = " + ", ".join(f"{h:g}" for h in h_values) + " µm")]
     return [*series_entries, *style_entries, *flag_entries]
 
 
@@ -361,7 +363,7 @@ def plot_fig17(ds: xr.Dataset, outputs) -> None:
 def plot_fig19(ds: xr.Dataset, outputs) -> None:
     fig, axes = new_figure(1, 1, width=7.0, height_per_row=4.2)
     sub = ds.sel(case="coated")
-    _forces(axes[0, 0], ds, "coated", window_note=f": mu = {float(sub['mu']):.3g} "
+    _forces(axes[0, 0], ds, "coated", window_note=f"; its mu = {float(sub['mu']):.3g} "
                                                   f"(analytical {float(sub['mu_analytical']):.3g})")
     header(fig, "fig19", axes_entries(axes), ncol=2)
     save(fig, outputs)
