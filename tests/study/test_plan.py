@@ -1,0 +1,119 @@
+"""plough plan (plough.study.plan): the projection of a workflow config before it runs, calibrated by measured jobs.
+
+The measured jobs here are made up, so that each projected time can be computed by hand: a run's time is its
+particle-steps (counted by plough.study.cost) over the rate of its family at the measured size nearest in log h.
+"""
+
+from __future__ import annotations
+
+import copy
+import json
+from pathlib import Path
+
+import pytest
+import xarray as xr
+import yaml
+
+from plough.cli import main
+from plough.io import to_json
+from plough.mpm.scene import Scene
+from plough.study import cost, matrix
+from plough.study.plan import Measured, Rates, load_config, make_plan, measured_from_benchmarks, merge
+
+ROOT = Path(__file__).resolve().parents[2]
+SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+
+
+def test_configfiles_merge_key_by_key_as_snakemake():
+    base = {"mpm": {"threads": 2, "ladder": "relative", "ladder_targets": {"contact_radius_particles": 12}},
+            "power_law": {"load_N": [1, 2]}}
+    merge(base, {"mpm": {"ladder": "paper", "ladder_targets": {"coating_particles": 1}}, "power_law": {"load_N": [3]}})
+    assert base == {"mpm": {"threads": 2, "ladder": "paper",
+                            "ladder_targets": {"contact_radius_particles": 12, "coating_particles": 1}},
+                    "power_law": {"load_N": [3]}}
+    config = load_config(["config/paper.yaml"], ROOT)
+    assert config["mpm"]["ladder"] == "paper"
+    assert config["mpm"]["ladder_targets"] == yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["mpm"][
+        "ladder_targets"]  # kept from config.yaml, as Snakemake keeps it
+
+
+def _row(run: str, family: str, h: float, steps: float, seconds: float, threads: int = 2) -> Measured:
+    return Measured(run, family, h, steps, seconds, threads, "test")
+
+
+def test_rates_per_family_at_the_nearest_measured_size():
+    rows = [_row("a", "rigid-plastic", 10, 2e9, 1000), _row("b", "rigid-plastic", 10, 1e9, 1000),
+            _row("c", "rigid-plastic", 20, 1e8, 200), _row("d", "real materials", 5, 3e9, 1000, threads=4),
+            _row("a", "rigid-plastic", 10, 2e9, 500)]  # measured again: the last row counts
+    rates = Rates.from_measured(rows, threads=2)
+    assert rates.rate("rigid-plastic", 10) == pytest.approx(3e9 / 1500)
+    assert rates.rate("rigid-plastic", 2.5) == pytest.approx(3e9 / 1500)  # nearest in log h: 10
+    assert rates.rate("rigid-plastic", 40) == pytest.approx(1e8 / 200)
+    assert rates.rate("rigid-plastic", 14) == pytest.approx(3e9 / 1500)  # nearer in log h to 10 than to 20
+    assert rates.rate("rigid-plastic", 15) == pytest.approx(1e8 / 200)
+    assert rates.rate("real materials", 80) == pytest.approx(3e9 / 2000)  # 4 threads scaled to 2, linearly
+    only_rp = Rates.from_measured(rows[:3], threads=2)
+    assert only_rp.rate("real materials", 5) == pytest.approx(cost.THROUGHPUT_PER_THREAD * 2)
+
+
+def _calibration(tmp_path: Path, rows: list[dict]) -> Path:
+    path = tmp_path / "projection_check_test.json"
+    path.write_text(json.dumps({"config": "none.yaml", "runs": rows}))
+    return path
+
+
+def test_the_plan_of_a_config_from_measured_jobs(tmp_path):
+    config = copy.deepcopy(SMOKE)
+    config["mpm"]["threads"] = 1
+    calib = _calibration(tmp_path, [
+        {"run": "x", "family": "rigid-plastic", "h_um": 14.0, "particle_steps": 1e8, "measured_s": 100.0},
+        {"run": "y", "family": "real materials", "h_um": 14.0, "particle_steps": 1e8, "measured_s": 400.0}])
+    plan = make_plan(config, cores=4, directory=tmp_path, calibration=[calib], cluster=8)
+    runs = matrix.all_runs(config)
+    assert set(plan.runs) == set(runs)
+    for rid, scene in runs.items():
+        s = Scene.from_dict(scene)
+        real = not rid.startswith("rp_")
+        steps = cost.estimate(s).particle_steps
+        # the JSON names no config file that exists: its jobs ran at 2 threads, scaled to this config's 1
+        rate = 1e8 / (400.0 if real else 100.0) / 2
+        assert plan.runs[rid].here_s == pytest.approx(steps / rate), rid
+        assert plan.runs[rid].cluster_s == pytest.approx(steps / rate / 8), rid
+        assert plan.runs[rid].request_min == cost.runtime_minutes(cost.estimate(s), 8)
+    # four jobs at once with --cores 4 and one thread a run; never less than the longest run
+    assert plan.parallel_jobs == 4
+    total = sum(r.here_s for r in plan.runs.values())
+    assert plan.wall_s(list(plan.runs)) == pytest.approx(max(total / 4, max(r.here_s for r in plan.runs.values())))
+    assert plan.figures["fig03"] == [] and plan.figures["fig22"] == plan.figures["fig21"]
+    assert set(plan.figures["fig12"]) == set(matrix.figure_runs(config, "fig12"))
+
+
+def test_benchmark_files_of_the_configs_runs_calibrate_markers_do_not(tmp_path):
+    runs = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(SMOKE).items()}
+    made, marker, stranger = sorted(runs)[:2] + ["not_a_run_h10"]
+    (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
+    (tmp_path / "results" / "runs").mkdir(parents=True)
+    for rid, seconds in ((made, 12.5), (marker, 0.4), (stranger, 99.0)):
+        (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
+    xr.Dataset(attrs={"cost_particle_steps": 1, "cost_threads": 1, "scene": to_json(runs[made].to_dict())}).to_netcdf(
+        tmp_path / "results" / "runs" / f"{made}.nc")
+    xr.Dataset(attrs={"skipped_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
+    rows = measured_from_benchmarks(tmp_path, runs, threads=2)
+    assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 1)]
+    assert rows[0].particle_steps == cost.estimate(runs[made]).particle_steps
+
+
+def test_plough_plan_prints_every_figure_and_the_total(capsys, tmp_path):
+    for path in ("config/config.yaml", "config/smoke.yaml", "profiles/slurm/config.yaml"):
+        (tmp_path / path).parent.mkdir(parents=True, exist_ok=True)
+        (tmp_path / path).write_text((ROOT / path).read_text())
+    assert main(["plan", "--directory", str(tmp_path), "--configfile", "config/smoke.yaml"]) == 0
+    out = capsys.readouterr().out
+    assert "ladder: paper (20, 14, 10 um for every point)" in out
+    for fig in ("fig03", "fig11", "fig12", "fig22", "fig23"):
+        assert f"| {fig} |" in out
+    assert f"| **all** (each run once) | {len(matrix.all_runs(SMOKE))} |" in out
+    assert "on a cluster, one job a run at 8 threads" in out  # profiles/slurm: set-threads mpm_run 8
+    # no measured job given: both families at the cluster request's rate, said so
+    assert out.count("none measured") == 2
+    assert main(["plan", "--directory", str(tmp_path), "--cores", "0"]) == 2
