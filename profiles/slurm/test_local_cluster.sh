@@ -14,11 +14,14 @@
 #   wants at least 120 s), and to submit without an account (--slurm-no-account: with no accounting there is
 #   no account to guess);
 # * the node declared with 16 CPUs (SlurmdParameters=config_overrides) on a machine with fewer cores, so that
-#   the profile's 8 threads a run fit; NUMBA_NUM_THREADS=8 for the same reason (numba refuses more threads
-#   than it was started with, by default the machine's core count);
-# * no cgroups in a container: proctrack/linuxproc and task/none.
-# The daemons, their state and logs live under WORKDIR/slurm (SLURM_CONF points there; /etc/slurm is not
-# touched); the daemons this script starts are stopped at its end, by their process ids.
+#   the profile's 8 threads a run are allocated (inside the job Snakemake then runs the rule on the cores the
+#   machine has);
+# * no cgroups in a container: proctrack/linuxproc and task/none;
+# * the configuration at /etc/slurm/slurm.conf, Slurm's default path: the executor's job step drops SLURM_CONF
+#   (every SLURM_ variable but the job's identity) from the environment of the srun it calls inside the job.
+#   The file is written only where none is or where this script wrote it (its first line says so).
+# The daemons' state and logs live under WORKDIR/slurm, started afresh each time; the daemons this script
+# starts are stopped at its end, by their process ids.
 set -euo pipefail
 
 if [[ $(id -u) -ne 0 ]]; then
@@ -60,10 +63,17 @@ if ! munge -n >/dev/null 2>&1; then
 fi
 munge -n | unmunge >/dev/null
 
-log "slurm: a single node, $HOST, configuration in $STATE"
-mkdir -p "$STATE/slurmctld" "$STATE/slurmd"
-export SLURM_CONF=$STATE/slurm.conf
-cat >"$SLURM_CONF" <<EOF
+CONF=/etc/slurm/slurm.conf
+MARK="# written by plough's profiles/slurm/test_local_cluster.sh"
+log "slurm: a single node, $HOST, configuration in $CONF, state and logs in $STATE"
+if [[ -e $CONF ]] && [[ $(head -n 1 "$CONF") != "$MARK" ]]; then
+    echo "test_local_cluster.sh: $CONF exists and is not this script's: not overwriting a real cluster's" >&2
+    exit 2
+fi
+rm -rf "$STATE"
+mkdir -p "$STATE/slurmctld" "$STATE/slurmd" /etc/slurm
+cat >"$CONF" <<EOF
+$MARK
 ClusterName=plough-local
 SlurmctldHost=$HOST(127.0.0.1)
 SlurmUser=root
@@ -90,9 +100,9 @@ SlurmdParameters=config_overrides
 NodeName=$HOST NodeAddr=127.0.0.1 CPUs=16 RealMemory=16000 State=UNKNOWN
 PartitionName=local Nodes=$HOST Default=YES MaxTime=INFINITE State=UP
 EOF
-/usr/sbin/slurmctld -f "$SLURM_CONF"
+/usr/sbin/slurmctld
 started+=("$STATE/slurmctld.pid")
-/usr/sbin/slurmd -f "$SLURM_CONF" -N "$HOST"
+/usr/sbin/slurmd -N "$HOST"
 started+=("$STATE/slurmd.pid")
 for _ in $(seq 60); do
     [[ $(sinfo -h -N -o %T 2>/dev/null) == idle ]] && break
@@ -111,7 +121,7 @@ log "the smoke matrix through profiles/slurm"
 cd "$WORK/plough"
 start=$(date +%s)
 set +e
-NUMBA_NUM_THREADS=8 "$WORK/venv/bin/python" -m snakemake --profile profiles/slurm --configfile=config/smoke.yaml \
+"$WORK/venv/bin/python" -m snakemake --profile profiles/slurm --configfile=config/smoke.yaml \
     --slurm-status-command squeue --slurm-no-account 2>&1 | tee "$WORK/snakemake.log"
 status=${PIPESTATUS[0]}
 set -e
