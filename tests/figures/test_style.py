@@ -75,6 +75,17 @@ def test_header_reads_row_by_row_and_drops_repeated_labels():
     plt.close(fig)
 
 
+@pytest.mark.parametrize(("figure", "width"), [("fig15", 6.5), ("fig11", 10.0)])
+def test_a_key_of_long_labels_takes_fewer_columns_and_fits(figure, width):
+    """Thirteen labels of 60 characters asked for in four columns: the key drops columns until it fits."""
+    fig, axes = new_figure(1, 2, width=width)
+    entries = [(Line2D([], [], color="k"), f"entry {i:2d}: " + "a long explanation of a mark " * 2) for i in range(13)]
+    legend = header(fig, figure, entries, ncol=4)
+    assert legend._ncols < 4
+    check_header(fig, figure)
+    plt.close(fig)
+
+
 @pytest.mark.parametrize("figure", ["fig03", "fig04", "fig22"])
 def test_analytical_figures_have_one_key_and_a_question(figure, tmp_path):
     ds = build_dataset(figure, CONFIGS["smoke"][config_section(figure)])

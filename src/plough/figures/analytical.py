@@ -106,7 +106,7 @@ def plot_fig22(ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
             ax.plot(x[~flagged], mpm[~flagged], ls="none", marker="o", ms=6, color="k", zorder=4)
             if flagged.any():
                 ax.plot(x[flagged], mpm[flagged], ls="none", marker="o", ms=6, mfc="white", color="k", zorder=4,
-                        label="hollow: MPM extrapolation flagged (least squares / two sizes)")
+                        label="hollow: flagged (fallback fit)")
             if "mu_mpm_failed_finest" in ds:
                 stopped = ds["mu_mpm_failed_finest"].sel(ball_diameter_mm=d).values.astype(bool)
                 if stopped.any():
@@ -118,7 +118,7 @@ def plot_fig22(ds: xr.Dataset, outputs: list[str | os.PathLike[str]]) -> None:
     entries = axes_entries(axes)
     if "mu_mpm" in ds:
         entries.insert(3, (Line2D([], [], color="0.3", lw=1.0, marker="o", ms=6, mfc="k", mec="k"),
-                           "line + marks: MPM friction extrapolated to h -> 0"))
+                           "line + marks: MPM friction, h -> 0"))
     warning = (note_entry("tab:red"), "fit constants as printed: inconsistent in SI (docs/model.md)")
     header(fig, "fig22", [*entries, warning], ncol=2)
     save(fig, outputs)

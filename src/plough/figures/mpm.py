@@ -39,9 +39,9 @@ TREND_WIDTH = 1.6
 #: per-size values: faint, under everything else
 FAINT = 0.3
 #: the key's entries for the flags and encodings the sweep figures share
-UNSTEADY_LABEL = "x: run not steady (mu_drift or prow growth in its window)"
-FLAGGED_LABEL = "hollow: extrapolation flagged (least squares / two sizes)"
-WORN_LABEL = "shaded: coating worn through (MPM dp > t)"
+UNSTEADY_LABEL = "x: run not steady"
+FLAGGED_LABEL = "hollow: flagged (fallback fit)"
+WORN_LABEL = "shaded: coating worn through (dp > t)"
 SERIES_NAMES = {"zinc_block": "zinc block", "steel": "DX56 steel", "coated": "zinc-coated steel"}
 
 
@@ -159,7 +159,7 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
     sizes = SideBySide(Line2D([], [], ls="none", marker=SIZE_MARKERS[k % 5], ms=4, color="0.3", alpha=0.6)
                   for k in range(h_values.size))
     style_entries = [(Line2D([], [], color="k", lw=TREND_WIDTH, marker="o", ms=MARK_SIZE),
-                      "line + marks: MPM extrapolated to h -> 0"),
+                      "line + marks: MPM, h -> 0"),
                      *([(Line2D([], [], color="k", lw=1.2, ls="--"), "dashed: analytical model")]
                        if any_analytical else []),
                      *([(Line2D([], [], ls="none", color="k", marker="o", ms=MARK_SIZE, mfc="white"),
@@ -241,7 +241,7 @@ def plot_fig18(ds: xr.Dataset, outputs) -> None:
     ax.axhspan(bulk - unc, bulk + unc, color="0.85", zorder=0)
     line = ax.axhline(bulk, color="k", ls="-.", lw=1.2, zorder=2.8)
     band = (Patch(color="0.85"), line)
-    header(fig, "fig18", [*entries, (band, "dash-dot: bulk zinc, MPM h -> 0 (band: its uncertainty)")], ncol=2)
+    header(fig, "fig18", [*entries, (band, "dash-dot + band: bulk zinc, MPM h -> 0")], ncol=2)
     save(fig, outputs)
 
 

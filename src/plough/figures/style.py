@@ -71,11 +71,17 @@ def header(fig: Figure, figure: str, entries: list[tuple[Artist, str]], ncol: in
     if ncol is None:  # as many columns as the width takes at about 2.4 inches an entry
         ncol = int(fig.get_figwidth() // 2.4)
     ncol = max(1, min(len(handles), ncol))
-    order = _row_major(len(handles), ncol)
-    legend = fig.legend([handles[i] for i in order], [labels[i] for i in order], loc="outside upper center",
-                        ncol=ncol, fontsize=KEY_FONTSIZE, frameon=False, columnspacing=1.2, handlelength=2.2,
-                        title=QUESTIONS[figure], title_fontsize=TITLE_FONTSIZE, alignment="center",
-                        handler_map={SideBySide: HandlerTuple(ndivide=None)})
+    while True:  # fewer columns until the key fits the figure's width (long labels make wide columns)
+        order = _row_major(len(handles), ncol)
+        legend = fig.legend([handles[i] for i in order], [labels[i] for i in order], loc="outside upper center",
+                            ncol=ncol, fontsize=KEY_FONTSIZE, frameon=False, columnspacing=1.2, handlelength=2.2,
+                            title=QUESTIONS[figure], title_fontsize=TITLE_FONTSIZE, alignment="center",
+                            handler_map={SideBySide: HandlerTuple(ndivide=None)})
+        width = legend.get_window_extent(fig.canvas.get_renderer()).width
+        if ncol == 1 or width <= 0.98 * fig.bbox.width:
+            break
+        legend.remove()
+        ncol -= 1
     for i, text in zip(order, legend.get_texts(), strict=True):
         if isinstance(handles[i], Artist) and handles[i].get_gid() == "note":
             text.set_color(handles[i].get_color())
@@ -121,7 +127,7 @@ def shade_where(ax, x, mask, label: str | None = None) -> None:
 
 
 #: legend of the ring around an MPM point whose finest run stopped unstable (mpm.finest_failure: record)
-FAILED_FINEST_LABEL = "finest run stopped unstable: from the two coarser sizes"
+FAILED_FINEST_LABEL = "ringed: finest run failed, from two sizes"
 
 
 def ring(ax, x, y, label: str | None = None) -> None:
