@@ -27,6 +27,8 @@ from plough.materials import (
     rigid_plastic,
 )
 from plough.mpm import constitutive as c
+from plough.mpm.bundles import MaterialData
+from plough.mpm.particles import particles_of
 
 RIGID = rigid_plastic("rp_substrate", 900e6, coating=False)
 MATERIALS = {"constant": RIGID, "bvl": DX56, "jc": ZINC_BULK, "power": ZINC_COATING}
@@ -58,6 +60,13 @@ def expected_flow(mat: Material, eps: float, rate: float, T: float) -> float:
 def rest(prm_a: np.ndarray, prm_b: np.ndarray, frac_a: float, eps_p: np.ndarray, temp: np.ndarray) -> np.ndarray:
     """The flow stress at rest of a one-particle state, the cache ``update_stress`` reads and keeps."""
     return np.array([c.mixed_flow_stress(prm_a, prm_b, frac_a, eps_p[0], 0.0, temp[0])])
+
+
+def one_particle_step(stress, L, dt, J, eps_p, temp, sy0, deps_last, prm_a, prm_b, frac_a, rate_scale, tq):
+    """``update_stress`` of a one-particle state of materials prm_a / prm_b; its arrays are updated in place."""
+    P = particles_of(1, stress=stress, J=np.array([J], dtype=float), eps_p=eps_p, temperature=temp, sigma_y0=sy0,
+                     deps_last=deps_last, mat_b=np.ones(1, dtype=np.int32), frac_a=np.array([frac_a], dtype=float))
+    return c.update_stress(P, 0, L, dt, MaterialData(np.stack([prm_a, prm_b]), rate_scale, tq))
 
 
 def von_mises(row: np.ndarray) -> float:
@@ -92,7 +101,7 @@ def drive(mat: Material, L: np.ndarray, dt: float, nsteps: int, rate_scale: floa
         F = step @ F
         J = float(np.linalg.det(F))
         T_before = float(temp[0])
-        deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, deps_last, prm, prm, 1.0, rate_scale, tq)
+        deps, w = one_particle_step(stress, L, dt, J, eps_p, temp, sy0, deps_last, prm, prm, 1.0, rate_scale, tq)
         assert sy0[0] == c.flow_stress(prm, float(eps_p[0]), 0.0, float(temp[0]))  # the cache stays exact
         hist["vm"].append(von_mises(stress[0]))
         hist["eps_p"].append(float(eps_p[0]))
@@ -305,7 +314,7 @@ def test_elastic_below_yield() -> None:
     eps_p = np.zeros(1)
     temp = np.full(1, T_ROOM)
     J = 1.0 + np.trace(eps)
-    deps, w = c.update_stress(stress, 0, eps / dt, dt, J, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), np.zeros(1),
+    deps, w = one_particle_step(stress, eps / dt, dt, J, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), np.zeros(1),
                               prm, prm,
                               1.0, 0.01, 0.9)
     dev = eps - np.trace(eps) / 3 * np.eye(3)
@@ -350,7 +359,7 @@ def test_rigid_rotation_preserves_invariants() -> None:
     temp = np.full(1, T_ROOM)
     sy0 = rest(prm, prm, 1.0, eps_p, temp)
     for _ in range(n):
-        c.update_stress(stress, 0, W, dt, J, eps_p, temp, sy0, np.zeros(1), prm, prm, 1.0, 0.01, 0.9)
+        one_particle_step(stress, W, dt, J, eps_p, temp, sy0, np.zeros(1), prm, prm, 1.0, 0.01, 0.9)
     assert von_mises(stress[0]) == pytest.approx(75e6, rel=1e-12)
     assert pressure(stress[0]) == pytest.approx(p0, rel=1e-12)
     assert eps_p[0] == 0.0 and temp[0] == T_ROOM
@@ -371,7 +380,7 @@ def test_rotation_direction_matches_spin() -> None:
     dt = 1e-5
     stress = voigt(s0)[None, :].copy()
     eps_p, temp = np.zeros(1), np.full(1, T_ROOM)
-    c.update_stress(stress, 0, W, dt, 1.0, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), np.zeros(1), prm, prm, 1.0,
+    one_particle_step(stress, W, dt, 1.0, eps_p, temp, rest(prm, prm, 1.0, eps_p, temp), np.zeros(1), prm, prm, 1.0,
                     1.0, 0.9)
     Q = _rodrigues(w, dt)
     exact = Q @ s0 @ Q.T
@@ -528,8 +537,8 @@ def test_adiabatic_heating(frac_a: float) -> None:
     stress = np.array([[2 * q / 3, -q / 3, -q / 3, 0.0, 0.0, 0.0]])
     eps_p = np.full(1, eps0)
     temp = np.full(1, T0)
-    deps, w = c.update_stress(
-        stress, 0, np.zeros((3, 3)), dt, 1.0, eps_p, temp, rest(pa, pb, frac_a, eps_p, temp), np.zeros(1), pa, pb,
+    deps, w = one_particle_step(
+        stress, np.zeros((3, 3)), dt, 1.0, eps_p, temp, rest(pa, pb, frac_a, eps_p, temp), np.zeros(1), pa, pb,
         frac_a, rate_scale, tq
     )
     rate = deps / dt * rate_scale
@@ -565,25 +574,15 @@ def test_parallel_driver_matches_single_updates() -> None:
     deps_last = np.where(rng.random(n) < 0.5, 10.0 ** rng.uniform(-12, -2, n), 0.0)
     ref = (stress.copy(), eps_p.copy(), temp.copy(), sy0.copy(), deps_last.copy())
     ref_d, ref_w = np.zeros(n), np.zeros(n)
+    M = MaterialData(table, rs, tq)
+    P_ref = particles_of(n, stress=ref[0], J=J, eps_p=ref[1], temperature=ref[2], sigma_y0=ref[3], deps_last=ref[4],
+                         mat_a=mat_a, mat_b=mat_b, frac_a=frac_a)
     for i in range(n):
-        ref_d[i], ref_w[i] = c.update_stress(
-            ref[0],
-            i,
-            L_all[i],
-            dt,
-            J[i],
-            ref[1],
-            ref[2],
-            ref[3],
-            ref[4],
-            table[mat_a[i]],
-            table[mat_b[i]],
-            frac_a[i],
-            rs,
-            tq,
-        )
+        ref_d[i], ref_w[i] = c.update_stress(P_ref, i, L_all[i], dt, M)
     d, w = np.zeros(n), np.zeros(n)
-    c.update_stresses(stress, L_all, dt, J, eps_p, temp, sy0, deps_last, mat_a, mat_b, frac_a, table, rs, tq, d, w)
+    P = particles_of(n, stress=stress, J=J, eps_p=eps_p, temperature=temp, sigma_y0=sy0, deps_last=deps_last,
+                     mat_a=mat_a, mat_b=mat_b, frac_a=frac_a)
+    c.update_stresses(P, L_all, dt, M, d, w)
     for got, want in zip((stress, eps_p, temp, sy0, deps_last, d, w), (*ref, ref_d, ref_w), strict=True):
         np.testing.assert_allclose(got, want, rtol=1e-14, atol=0)
     assert (d > 0).sum() > n // 4  # the random states exercise the plastic branch
@@ -625,7 +624,7 @@ def test_property_never_outside_yield_surface(
     eps_p = np.full(1, eps0)
     temp = np.full(1, T0)
     sy0 = rest(TABLE[ia], TABLE[ib], frac, eps_p, temp)
-    deps, w = c.update_stress(stress, 0, L, dt, J, eps_p, temp, sy0, np.zeros(1), TABLE[ia], TABLE[ib], frac, rs,
+    deps, w = one_particle_step(stress, L, dt, J, eps_p, temp, sy0, np.zeros(1), TABLE[ia], TABLE[ib], frac, rs,
                               0.9)
     assert np.all(np.isfinite(stress)) and math.isfinite(deps) and math.isfinite(w)
     assert math.isfinite(temp[0]) and temp[0] >= T0

@@ -22,8 +22,10 @@ import pytest
 
 from plough.materials import rigid_plastic
 from plough.mpm import contact as ct
+from plough.mpm.bundles import ContactLaw, SphereData, grid_of, whole
 from plough.mpm.constitutive import pack_materials, rest_flow_stresses
 from plough.mpm.grid import Grid
+from plough.mpm.particles import particles_of
 from plough.mpm.shape import bspline2, bspline2_grad
 
 DX = 1e-5
@@ -81,12 +83,21 @@ def no_memory():
     return np.full(N_NODES, ct.NEVER_PUSHED), 0, HOLD
 
 
+def run_contact(grid_m, grid_v, cbuf, flags, memory, centre, radius, v_sphere, model, iparams):
+    """``sphere_contact`` on this grid with the contact ``memory`` (last_push, step, hold_steps); the reaction."""
+    last_push, step, hold_steps = memory
+    out = np.zeros(ct.N_OUT)
+    G = grid_of(ORIGIN, DX, SHAPE, m=grid_m, v=grid_v, cbuf=cbuf, flags=flags, last_push=last_push)
+    ct.sphere_contact(G, SphereData(np.asarray(centre, float), v_sphere, radius, 3 * DX),
+                      ContactLaw(model, np.asarray(iparams, float), hold_steps), step, DT, out)
+    return out
+
+
 def call(case, model, iparams):
     grid_v = case["grid_v"].copy()
     cbuf = case["cbuf"].copy()
-    out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(case["grid_m"], grid_v, cbuf, NO_FLAGS, *no_memory(), ORIGIN, DX, SHAPE, case["centre"],
-                      case["radius"], case["v_sphere"], DT, model, np.asarray(iparams, float), out)
+    out = run_contact(case["grid_m"], grid_v, cbuf, NO_FLAGS, no_memory(), case["centre"], case["radius"],
+                      case["v_sphere"], model, iparams)
     return grid_v, cbuf, out
 
 
@@ -164,10 +175,9 @@ def test_pressing_on_resting_material_gives_upward_normal_force():
     grid_v = np.zeros((N_NODES, 3))
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
     cbuf[:, 8] = DX  # touching, but no stress: kappa = 0
-    out = np.zeros(ct.N_OUT)
     v_sphere = np.array([0.0, 0.0, -0.05])
-    ct.sphere_contact(grid_m, grid_v, cbuf, NO_FLAGS, *no_memory(), ORIGIN, DX, SHAPE, centre, 3.3 * DX, v_sphere, DT,
-                      ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), out)
+    out = run_contact(grid_m, grid_v, cbuf, NO_FLAGS, no_memory(), centre, 3.3 * DX, v_sphere,
+                      ct.INTERFACE_PROPORTIONAL, [1.0, 0.0])
     assert out[ct.OUT_FN + 2] > 0  # material pushes the sphere up
     # nodes below the centre move down with the sphere's normal velocity
     below = (np.linalg.norm(NODES - centre, axis=1) < 4.3 * DX) & (NODES[:, 2] < centre[2])
@@ -306,8 +316,9 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     cbuf = np.zeros((N_NODES, ct.N_CBUF))
     sigma_y0 = np.zeros(n)
     rest_flow_stresses(eps_p, temperature, mat_a, mat_b, frac_a, table, sigma_y0)
-    ct.scatter_contact_stress(x, stress, mass, vol0, J, sigma_y0, near, ORIGIN, DX, SHAPE, centre, radius, -1, cbuf, 0,
-                              n)
+    P = particles_of(n, x=x, stress=stress, mass=mass, vol0=vol0, J=J, sigma_y0=sigma_y0, near=near)
+    ct.scatter_contact_stress(P, grid_of(ORIGIN, DX, SHAPE, cbuf=cbuf), SphereData(centre, np.zeros(3), radius, 3 * DX),
+                              whole(n, SHAPE))
     # independent accumulation
     sy = np.array([450e6 / 3, 900e6 / 3])
     kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
@@ -370,9 +381,8 @@ def one_node_case(rel_velocity_n, rel_velocity_t, prox, kappa=1.0e8, pressure=3.
 
 def call_with_memory(c, last_push, step, hold_steps, f=1.0):
     grid_v = c["grid_v"].copy()
-    out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(c["grid_m"], grid_v, c["cbuf"].copy(), NO_FLAGS, last_push, step, hold_steps, ORIGIN, DX, SHAPE,
-                      c["centre"], c["radius"], c["v_sphere"], DT, ct.INTERFACE_PROPORTIONAL, np.array([f, 0.0]), out)
+    out = run_contact(c["grid_m"], grid_v, c["cbuf"].copy(), NO_FLAGS, (last_push, step, hold_steps), c["centre"],
+                      c["radius"], c["v_sphere"], ct.INTERFACE_PROPORTIONAL, [f, 0.0])
     rel = grid_v[c["node"]] - c["v_sphere"]
     return rel @ c["n"], rel @ c["t"], out
 
@@ -456,10 +466,10 @@ def _scatter_block(x, h, centre, radius, mirror_j0=-1):
     sigma_y0 = np.zeros(n)
     rest_flow_stresses(np.zeros(n), np.full(n, 298.0), np.zeros(n, dtype=np.int32), np.zeros(n, dtype=np.int32), ones,
                        pack_materials([rigid_plastic("sub", 900e6, coating=False)]), sigma_y0)
-    cbuf = np.zeros((N_NODES, ct.N_CBUF))
-    ct.scatter_contact_stress(x, np.zeros((n, 6)), ones, np.full(n, (h * DX) ** 3), ones, sigma_y0,
-                              np.ones(n, dtype=np.int8), ORIGIN, DX, SHAPE, centre, radius, mirror_j0, cbuf, 0, n)
-    return cbuf
+    G = grid_of(ORIGIN, DX, SHAPE, mirror_j0=mirror_j0)
+    P = particles_of(n, x=x, vol0=np.full(n, (h * DX) ** 3), sigma_y0=sigma_y0, near=np.ones(n, dtype=np.int8))
+    ct.scatter_contact_stress(P, G, SphereData(np.asarray(centre), np.zeros(3), radius, 3 * DX), whole(n, SHAPE))
+    return G.cbuf
 
 
 def _scatter_surface(x, h, mirror_j0=-1):
@@ -515,7 +525,6 @@ def test_contact_consumes_every_folded_surface_vector(centre_y):
     assert np.abs(cbuf[:, ct.C_AREA:]).max() > 0.1 * DX * DX  # the sphere reaches the block's surface
     j = (np.arange(N_NODES) // SHAPE[2]) % SHAPE[1]
     flags = np.where(j < j0, GHOST, np.where(j == j0, MIRROR, 0)).astype(np.int8)
-    out = np.zeros(ct.N_OUT)
-    ct.sphere_contact(np.ones(N_NODES), np.zeros((N_NODES, 3)), cbuf, flags, *no_memory(), ORIGIN, DX, SHAPE, centre,
-                      radius, np.array([0.1, 0.0, 0.0]), DT, ct.INTERFACE_PROPORTIONAL, np.array([1.0, 0.0]), out)
+    run_contact(np.ones(N_NODES), np.zeros((N_NODES, 3)), cbuf, flags, no_memory(), centre, radius,
+                np.array([0.1, 0.0, 0.0]), ct.INTERFACE_PROPORTIONAL, [1.0, 0.0])
     np.testing.assert_array_equal(cbuf, 0.0)

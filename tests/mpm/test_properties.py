@@ -30,7 +30,9 @@ from hypothesis import strategies as st
 from plough.materials import DX56, ZINC_BULK, ZINC_COATING, reference_flow_stress, rigid_plastic
 from plough.mpm import constitutive as c
 from plough.mpm import contact as ct
+from plough.mpm.bundles import ContactLaw, SphereData, grid_of
 from plough.mpm.grid import FIXED, FREE, GHOST, MIRROR, Grid
+from tests.mpm.test_constitutive import one_particle_step
 
 EPS = np.finfo(float).eps
 TQ = 0.9  # Taylor-Quinney factor
@@ -135,7 +137,7 @@ def run_update(state: dict, s_old: np.ndarray, L: np.ndarray, dt: float, rate_sc
     temp = np.full(1, state["T0"])
     sy0 = np.array([c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])])
     deps_last = np.full(1, state["guess"])
-    deps, w = c.update_stress(stress, 0, np.ascontiguousarray(L), dt, state["J"], eps_p, temp, sy0, deps_last,
+    deps, w = one_particle_step(stress, np.ascontiguousarray(L), dt, state["J"], eps_p, temp, sy0, deps_last,
                               ROW[state["a"]], ROW[state["b"]], state["frac"], rate_scale, TQ)
     assert deps_last[0] == (deps if deps > 0.0 else state["guess"])
     # the cache of the flow stress at rest follows the new plastic strain and temperature exactly
@@ -232,7 +234,7 @@ def test_pure_spin_preserves_invariants(state, wdir, log_w, log_dt, nsteps):
     temp = np.full(1, state["T0"])
     sy0 = np.array([c.mixed_flow_stress(ROW[state["a"]], ROW[state["b"]], state["frac"], eps_p[0], 0.0, temp[0])])
     for _ in range(nsteps):
-        deps, wp = c.update_stress(stress, 0, W, dt, state["J"], eps_p, temp, sy0, np.zeros(1), ROW[state["a"]],
+        deps, wp = one_particle_step(stress, W, dt, state["J"], eps_p, temp, sy0, np.zeros(1), ROW[state["a"]],
                                    ROW[state["b"]], state["frac"], 1.0, TQ)
         assert deps == 0.0 and wp == 0.0
     assert eps_p[0] == state["eps0"] and temp[0] == state["T0"]
@@ -339,9 +341,9 @@ def call_contact(s: dict, grid_m=None, grid_v=None, cbuf=None):
     grid_v = (s["grid_v"] if grid_v is None else grid_v).copy()
     cbuf = (s["cbuf"] if cbuf is None else cbuf).copy()
     out = np.zeros(ct.N_OUT)
-    memory = np.full(N_NODES, ct.NEVER_PUSHED), 0, 6.0  # first step: no node held
-    ct.sphere_contact(s["grid_m"] if grid_m is None else grid_m, grid_v, cbuf, s["flags"], *memory, ORIGIN, DX, SHAPE,
-                      s["centre"], s["radius"], s["v_sphere"], s["dt"], s["model"], s["iparams"], out)
+    G = grid_of(ORIGIN, DX, SHAPE, m=s["grid_m"] if grid_m is None else grid_m, v=grid_v, cbuf=cbuf, flags=s["flags"])
+    law = ContactLaw(s["model"], s["iparams"], 6.0)  # first step: no node pushed before, none held
+    ct.sphere_contact(G, SphereData(s["centre"], s["v_sphere"], s["radius"], 3 * DX), law, 0, s["dt"], out)
     return grid_v, out
 
 

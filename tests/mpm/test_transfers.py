@@ -21,8 +21,10 @@ import pytest
 
 from plough.materials import rigid_plastic
 from plough.mpm import transfers as tr
+from plough.mpm.bundles import MaterialData, SphereData, grid_of, whole
 from plough.mpm.constitutive import I_G, I_K, pack_materials, rest_flow_stresses
 from plough.mpm.grid import FIXED, FREE, GHOST, MIRROR, Grid, boundary_flags, make_grid, mirror_plane_index
+from plough.mpm.particles import particles_of
 
 DX = 1e-5
 SHAPE = np.array([17, 16, 18], dtype=np.int64)  # non-cubic: catches index mix-ups
@@ -31,14 +33,9 @@ RHO = 7850.0
 STIFF = pack_materials([rigid_plastic("stiff", 1e15, coating=False)])  # never yields here
 
 
-def everything(x: np.ndarray, buf: np.ndarray) -> tuple[int, int, int, int]:
-    """The kernels' particle and node ranges covering every particle and node (no active zone)."""
-    return 0, x.shape[0], 0, buf.shape[1]
-
-
-def all_nodes(buf: np.ndarray, shape) -> tuple[int, int, int, int]:
-    """grid_update's node range and free x-index range covering the whole grid (nothing clamped)."""
-    return 0, buf.shape[1], 0, int(shape[0])
+def moving(x, v, C, stress, vol0, J, mass):
+    """The particle bundle of what P2G reads (the rest: defaults)."""
+    return particles_of(x.shape[0], x=x, v=v, C=C, stress=stress, vol0=vol0, J=J, mass=mass)
 
 
 def node_positions(origin=ORIGIN, dx=DX, shape=SHAPE) -> np.ndarray:
@@ -58,15 +55,12 @@ def random_particles(n=300, seed=0, lo_cells=3.0, hi_cells=None):
 
 
 def p2g_update(x, v, C, stress, vol0, J, mass, dt, n_chunks=1, flags=None):
-    n_nodes = int(np.prod(SHAPE))
-    buf = tr.allocate_grid_buffers(n_chunks, n_nodes)
-    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, dt, SHAPE, buf, *everything(x, buf))
-    grid_m = np.zeros(n_nodes)
-    grid_v = np.zeros((n_nodes, 6))
-    if flags is None:
-        flags = np.full(n_nodes, FREE, dtype=np.int8)
-    tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1, *all_nodes(buf, SHAPE))
-    return buf, grid_m, grid_v[:, :3].copy()  # the new velocity; columns 3:6 are tested on their own
+    G = grid_of(ORIGIN, DX, SHAPE, n_chunks)
+    if flags is not None:
+        G = G._replace(flags=flags)
+    tr.p2g(moving(x, v, C, stress, vol0, J, mass), G, dt, whole(x.shape[0], SHAPE))
+    tr.grid_update(G, whole(x.shape[0], SHAPE))
+    return G.buf, G.m, G.v[:, :3].copy()  # the new velocity; columns 3:6 are tested on their own
 
 
 def random_sym_stress(rng, n, scale=1e8):
@@ -134,12 +128,7 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     n = x.shape[0]
     if grid_v.shape[1] == 3:  # no FLIP increment: the old velocity equals the new one
         grid_v = np.hstack([grid_v, grid_v])
-    grid_div = np.zeros(grid_v.shape[0])
     v_grid = np.zeros((n, 3))
-    buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
-    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, v, C, v_grid, mass, flip, buf, project, *everything(x, buf))
-    if project:
-        tr.grid_dilatation(buf, grid_div, SHAPE, -1, 0, buf.shape[1])
     eps_p = np.zeros(n) if eps_p is None else eps_p
     temperature = np.full(n, 298.0)
     mat = np.zeros(n, dtype=np.int32)
@@ -152,9 +141,14 @@ def run_g2p(grid_v, x, v, C, stress, J, vol0, mass, dt, n_chunks=1, sphere_c=Non
     hi = ORIGIN + DX * (SHAPE - 2) if grid_hi is None else grid_hi
     sigma_y0 = np.zeros(n)
     rest_flow_stresses(eps_p, temperature, mat, mat, frac, table, sigma_y0)
-    tr.g2p_update(ORIGIN, DX, dt, SHAPE, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, sigma_y0,
-                  np.zeros(n), mat, mat, frac, table, 1.0, 0.9, sphere_c, sphere_r, near_dist, near, acc, lo, hi,
-                  grid_div, project, tr.allocate_velocity_gradient_scratch(n_chunks), 0, x.shape[0], block)
+    P = particles_of(n, x=x, v=v, C=C, stress=stress, J=J, vol0=vol0, mass=mass, eps_p=eps_p,
+                     temperature=temperature, sigma_y0=sigma_y0, mat_a=mat, mat_b=mat, frac_a=frac, near=near)
+    G, Z = grid_of(ORIGIN, DX, SHAPE, n_chunks, v=grid_v), whole(n, SHAPE, lo, hi)
+    tr.g2p_kinematics(P, G, v_grid, flip, project, Z)
+    if project:
+        tr.grid_dilatation(G, Z)
+    tr.g2p_update(P, G, MaterialData(table, 1.0, 0.9), SphereData(sphere_c, np.zeros(3), sphere_r, near_dist), Z, dt,
+                  project, v_grid, tr.allocate_velocity_gradient_scratch(n_chunks), acc, block)
     return acc, near, eps_p
 
 
@@ -307,10 +301,10 @@ def test_chunked_scatter_gives_same_grid():
         # chunk c holds exactly the scatter of its own contiguous particle slice
         for c in range(n_chunks):
             sl = slice(c * n // n_chunks, (c + 1) * n // n_chunks)
-            one = tr.allocate_grid_buffers(1, buf.shape[1])
-            tr.p2g(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl], ORIGIN, DX, 1e-8, SHAPE, one,
-                   *everything(x[sl], one))
-            np.testing.assert_array_equal(buf[c], one[0])
+            one = grid_of(ORIGIN, DX, SHAPE)
+            tr.p2g(moving(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl]), one, 1e-8,
+                   whole(sl.stop - sl.start, SHAPE))
+            np.testing.assert_array_equal(buf[c], one.buf[0])
     m1, v1 = results[1]
     vscale = np.abs(v1).max()
     for k in (2, 3):
@@ -328,10 +322,10 @@ def test_g2p_update_blocks_cover_every_particle_once():
     soft = pack_materials([rigid_plastic("soft", 3.0e7, coating=False)])  # some particles flow, some do not
     stress0 = random_sym_stress(rng, n) * 1e-2
     # the kinematics and the projected dilatation once, with one chunk: only g2p_update's split varies
-    C, v_grid, grid_div = np.zeros((n, 3, 3)), np.zeros((n, 3)), np.zeros(n_nodes)
-    buf = tr.allocate_grid_buffers(1, n_nodes)
-    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, v.copy(), C, v_grid, mass, 1.0, buf, 1, *everything(x, buf))
-    tr.grid_dilatation(buf, grid_div, SHAPE, -1, 0, n_nodes)
+    C, v_grid = np.zeros((n, 3, 3)), np.zeros((n, 3))
+    G = grid_of(ORIGIN, DX, SHAPE, v=grid_v)
+    tr.g2p_kinematics(particles_of(n, x=x, v=v.copy(), C=C, mass=mass), G, v_grid, 1.0, 1, whole(n, SHAPE))
+    tr.grid_dilatation(G, whole(n, SHAPE))
     mat, frac = np.zeros(n, dtype=np.int32), np.ones(n)
     lo, hi = ORIGIN + DX, ORIGIN + DX * (SHAPE - 2)
 
@@ -340,9 +334,12 @@ def test_g2p_update_blocks_cover_every_particle_once():
         eps_p, temperature, sigma_y0, deps_last = np.zeros(n), np.full(n, 298.0), np.zeros(n), np.zeros(n)
         rest_flow_stresses(eps_p, temperature, mat, mat, frac, soft, sigma_y0)
         near, acc = np.zeros(n, dtype=np.int8), np.zeros((n_chunks, tr.N_ACC))
-        tr.g2p_update(ORIGIN, DX, 1e-8, SHAPE, xs, v, v_grid, C, ss, Js, vol0, mass, eps_p, temperature, sigma_y0,
-                      deps_last, mat, mat, frac, soft, 1.0, 0.9, x.mean(0), 4 * DX, DX, near, acc, lo, hi, grid_div,
-                      1, tr.allocate_velocity_gradient_scratch(n_chunks), p_lo, p_hi, block)
+        P = particles_of(n, x=xs, v=v, C=C, stress=ss, J=Js, vol0=vol0, mass=mass, eps_p=eps_p,
+                         temperature=temperature, sigma_y0=sigma_y0, deps_last=deps_last, mat_a=mat, mat_b=mat,
+                         frac_a=frac, near=near)
+        Z = whole(n, SHAPE, lo, hi)._replace(p_lo=p_lo, p_hi=p_hi)
+        tr.g2p_update(P, G, MaterialData(soft, 1.0, 0.9), SphereData(x.mean(0), np.zeros(3), 4 * DX, DX), Z, 1e-8, 1,
+                      v_grid, tr.allocate_velocity_gradient_scratch(n_chunks), acc, block)
         return acc, (xs, ss, Js, near, eps_p, temperature, sigma_y0, deps_last)
 
     acc_ref, ref = run(1, n)
@@ -373,10 +370,10 @@ def test_p2g_zeroes_stale_buffer():
     _, x, v, vol0, J, mass = random_particles(seed=8)
     n = x.shape[0]
     C, stress = np.zeros((n, 3, 3)), np.zeros((n, 6))
-    buf = tr.allocate_grid_buffers(2, int(np.prod(SHAPE)))
-    buf[:] = 123.0
-    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, buf, *everything(x, buf))
-    assert buf[:, :, 0].sum() == pytest.approx(mass.sum(), rel=1e-13)
+    G = grid_of(ORIGIN, DX, SHAPE, 2)
+    G.buf[:] = 123.0
+    tr.p2g(moving(x, v, C, stress, vol0, J, mass), G, 1e-8, whole(n, SHAPE))
+    assert G.buf[:, :, 0].sum() == pytest.approx(mass.sum(), rel=1e-13)
 
 
 # ----------------------------------------------------------------------------- grid update
@@ -390,7 +387,8 @@ def test_grid_update_boundary_conditions():
     flags = rng.choice(np.array([FREE, FIXED, MIRROR], dtype=np.int8), n_nodes)
     grid_m = np.full(n_nodes, -1.0)
     grid_v = np.full((n_nodes, 6), 99.0)
-    tr.grid_update(buf, flags, grid_m, grid_v, np.array([1, 1, n_nodes], dtype=np.int64), -1, 0, n_nodes, 0, 1)
+    tr.grid_update(grid_of(ORIGIN, DX, [1, 1, n_nodes], buf=buf, flags=flags, m=grid_m, v=grid_v),
+                   whole(0, [1, 1, n_nodes]))
     m = buf[:, :, 0].sum(0)
     mom = buf[:, :, 1:4].sum(0)
     impulse = buf[:, :, 4:7].sum(0)
@@ -459,14 +457,13 @@ def test_mirror_fold_reproduces_the_full_domain():
     stress_m = stress * np.array([1, 1, 1, -1, 1, -1])  # yz and xy change sign
 
     def grid_v(grid, xs, vs, Cs, ss, symmetric):
-        shape = np.array(grid.shape, dtype=np.int64)
-        buf = tr.allocate_grid_buffers(1, grid.n_nodes)
-        tr.p2g(xs, vs, Cs, ss, np.tile(vol0, len(xs) // n), np.tile(J, len(xs) // n), np.tile(mass, len(xs) // n),
-               grid.origin, dx, 1e-7, shape, buf, *everything(xs, buf))
         flags = boundary_flags(grid, 1.0, symmetric)  # radius 1 m: nothing fixed
-        gm, gv = np.zeros(grid.n_nodes), np.zeros((grid.n_nodes, 6))
-        tr.grid_update(buf, flags, gm, gv, shape, mirror_plane_index(grid, symmetric), *all_nodes(buf, shape))
-        return gm, gv, flags
+        G = grid_of(grid.origin, dx, grid.shape, mirror_j0=mirror_plane_index(grid, symmetric), flags=flags)
+        k = len(xs) // n
+        tr.p2g(moving(xs, vs, Cs, ss, np.tile(vol0, k), np.tile(J, k), np.tile(mass, k)), G, 1e-7,
+               whole(len(xs), grid.shape))
+        tr.grid_update(G, whole(len(xs), grid.shape))
+        return G.m, G.v, flags
 
     gm_h, gv_h, flags_h = grid_v(half_grid, x, v, C, stress, True)
     gm_f, gv_f, _ = grid_v(full_grid, np.vstack([x, x_m]), np.vstack([v, v_m]), np.vstack([C, C_m]),
@@ -560,14 +557,13 @@ def test_dilatation_projection_matches_reference_and_conserves_mass_weighted_dil
     from the kernels' nodal field, sum_p m_p d_bar_p = sum_p m_p tr L_p, and the norm shrinks."""
     rng, x, _, _, _, mass = random_particles(n=500, seed=11)
     grid_v = rng.normal(0.0, 0.1, (int(np.prod(SHAPE)), 6))
-    buf = tr.allocate_grid_buffers(n_chunks, grid_v.shape[0])
-    buf[:] = 1.0  # stale content must not leak in
-    grid_div = np.full(grid_v.shape[0], np.nan)
+    G = grid_of(ORIGIN, DX, SHAPE, n_chunks, v=grid_v, div=np.full(grid_v.shape[0], np.nan))
+    G.buf[:] = 1.0  # stale content must not leak in
+    grid_div = G.div
     n = x.shape[0]
     C = np.zeros((n, 3, 3))
-    tr.g2p_kinematics(grid_v, ORIGIN, DX, SHAPE, x, np.zeros((n, 3)), C, np.zeros((n, 3)), mass, 0.0, buf, 1,
-                      *everything(x, buf))
-    tr.grid_dilatation(buf, grid_div, SHAPE, -1, 0, buf.shape[1])
+    tr.g2p_kinematics(particles_of(n, x=x, C=C, mass=mass), G, np.zeros((n, 3)), 0.0, 1, whole(n, SHAPE))
+    tr.grid_dilatation(G, whole(n, SHAPE))
     tr_ref, d_ref, _ = projection_reference(grid_v, x, mass)
     scale = np.abs(d_ref).max()
     np.testing.assert_allclose(grid_div, d_ref, rtol=0, atol=1e-12 * scale)
@@ -635,15 +631,12 @@ def test_dilatation_projection_with_the_mirror_plane_reproduces_the_full_domain(
                                 np.cos(pos[:, 2] / 5e-5 + pos[:, 1] ** 2 / 1e-9)])
 
     def project(grid, xs, ms, symmetric):
-        shape = np.array(grid.shape, dtype=np.int64)
         gv = np.hstack([velocity(grid.node_positions())] * 2)
-        buf = tr.allocate_grid_buffers(2, grid.n_nodes)
-        out = np.zeros(grid.n_nodes)
+        G = grid_of(grid.origin, dx, grid.shape, 2, mirror_j0=mirror_plane_index(grid, symmetric), v=gv)
         k = len(xs)
-        tr.g2p_kinematics(gv, grid.origin, dx, shape, xs, np.zeros((k, 3)), np.zeros((k, 3, 3)), np.zeros((k, 3)), ms,
-                          0.0, buf, 1, *everything(xs, buf))
-        tr.grid_dilatation(buf, out, shape, mirror_plane_index(grid, symmetric), 0, buf.shape[1])
-        return out
+        tr.g2p_kinematics(particles_of(k, x=xs, mass=ms), G, np.zeros((k, 3)), 0.0, 1, whole(k, grid.shape))
+        tr.grid_dilatation(G, whole(k, grid.shape))
+        return G.div
 
     d_h = project(half_grid, x, mass, True)
     d_f = project(full_grid, np.vstack([x, x * [1.0, -1.0, 1.0]]), np.concatenate([mass, mass]), False)
@@ -667,17 +660,19 @@ def test_p2g_over_a_particle_range_is_the_scatter_of_those_particles_and_keeps_o
     C, stress = rng.normal(0.0, 50.0, (n, 3, 3)), random_sym_stress(rng, n)
     n_nodes = int(np.prod(SHAPE))
     p_lo, p_hi = 100, 300
+    P = moving(x, v, C, stress, vol0, J, mass)
     for n_chunks in (1, 2):
         ranged = np.full((n_chunks, n_nodes, 7), 7.0)
-        tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, ranged, p_lo, p_hi, 0, n_nodes)
-        sub = tr.allocate_grid_buffers(1, n_nodes)
+        tr.p2g(P, grid_of(ORIGIN, DX, SHAPE, buf=ranged), 1e-8, whole(n, SHAPE)._replace(p_lo=p_lo, p_hi=p_hi))
+        sub = grid_of(ORIGIN, DX, SHAPE)
         sl = slice(p_lo, p_hi)
-        tr.p2g(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl], ORIGIN, DX, 1e-8, SHAPE, sub,
-               *everything(x[sl], sub))
-        np.testing.assert_allclose(ranged.sum(0), sub[0], rtol=1e-12, atol=1e-12 * np.abs(sub).max())
+        tr.p2g(moving(x[sl], v[sl], C[sl], stress[sl], vol0[sl], J[sl], mass[sl]), sub, 1e-8,
+               whole(p_hi - p_lo, SHAPE))
+        np.testing.assert_allclose(ranged.sum(0), sub.buf[0], rtol=1e-12, atol=1e-12 * np.abs(sub.buf).max())
     slab = SHAPE[1] * SHAPE[2]
     kept = np.full((1, n_nodes, 7), 7.0)
-    tr.p2g(x, v, C, stress, vol0, J, mass, ORIGIN, DX, 1e-8, SHAPE, kept, 0, 0, 4 * slab, 9 * slab)
+    tr.p2g(P, grid_of(ORIGIN, DX, SHAPE, buf=kept), 1e-8,
+           whole(n, SHAPE)._replace(p_lo=0, p_hi=0, n_lo=4 * slab, n_hi=9 * slab))
     assert np.all(kept[0, 4 * slab:9 * slab] == 0.0)  # the range was zeroed, no particle scattered
     assert np.all(kept[0, :4 * slab] == 7.0) and np.all(kept[0, 9 * slab:] == 7.0)
 
@@ -692,11 +687,13 @@ def test_grid_update_clamps_the_frozen_slabs_and_leaves_nodes_outside_its_range(
     buf[:, :, 0] = rng.uniform(0.1, 1.0, (2, n_nodes))
     buf[:, :, 1:] = rng.normal(0.0, 1.0, (2, n_nodes, 6))
     flags = np.full(n_nodes, FREE, dtype=np.int8)
-    full_m, full_v = np.zeros(n_nodes), np.zeros((n_nodes, 6))
-    tr.grid_update(buf, flags, full_m, full_v, SHAPE, -1, *all_nodes(buf, SHAPE))
+    full = grid_of(ORIGIN, DX, SHAPE, buf=buf, flags=flags)
+    tr.grid_update(full, whole(0, SHAPE))
+    full_m, full_v = full.m, full.v
     grid_m, grid_v = np.full(n_nodes, -1.0), np.full((n_nodes, 6), 99.0)
     n_lo, n_hi, i_free_lo, i_free_hi = 3 * slab, 12 * slab, 5, 9
-    tr.grid_update(buf, flags, grid_m, grid_v, SHAPE, -1, n_lo, n_hi, i_free_lo, i_free_hi)
+    tr.grid_update(grid_of(ORIGIN, DX, SHAPE, buf=buf, flags=flags, m=grid_m, v=grid_v),
+                   whole(0, SHAPE)._replace(n_lo=n_lo, n_hi=n_hi, i_free_lo=i_free_lo, i_free_hi=i_free_hi))
     i = np.arange(n_nodes) // slab
     inside = (np.arange(n_nodes) >= n_lo) & (np.arange(n_nodes) < n_hi)
     free = inside & (i >= i_free_lo) & (i <= i_free_hi)
@@ -720,7 +717,8 @@ def test_freeze_particles_stops_them_and_counts_their_energies():
     stress = random_sym_stress(rng, n)
     C, v_grid = rng.normal(0.0, 1.0, (n, 3, 3)), rng.normal(0.0, 1.0, (n, 3))
     v0, C0, v_grid0 = v.copy(), C.copy(), v_grid.copy()
-    elastic, kinetic = tr.freeze_particles(10, 30, v, C, v_grid, stress, J, vol0, mass, mat_a, mat_b, frac, table)
+    P = particles_of(n, v=v, C=C, stress=stress, J=J, vol0=vol0, mass=mass, mat_a=mat_a, mat_b=mat_b, frac_a=frac)
+    elastic, kinetic = tr.freeze_particles(P, v_grid, table, 10, 30)
     sl = slice(10, 30)
     assert kinetic == pytest.approx(0.5 * np.sum(mass[sl, None] * v0[sl] ** 2), rel=1e-13)
     # the elastic energy density of an isotropic solid: p^2 / 2K + s:s / 4G, moduli mixed by volume

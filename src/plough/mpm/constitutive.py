@@ -472,21 +472,21 @@ def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, 
 
 # ----------------------------------------------------------------------------- stress update
 @njit(cache=True)
-def update_stress(
-    stress, p, L, dt, J, eps_p, temperature, sigma_y0, deps_last, prm_a, prm_b, frac_a, rate_scale, taylor_quinney
-):
+def update_stress(P, p, L, dt, M):
     """Advance the Cauchy stress of particle ``p`` by one step (eqs. 6.1 and 6.2).
 
-    Reads: ``stress[p]`` ((n, 6) Voigt xx, yy, zz, yz, xz, xy; only its deviator is used), ``L``
-    ((3, 3) velocity gradient of the particle, L[i, j] = dv_i/dx_j), ``dt``, ``J`` (det F after
-    this step), ``eps_p[p]``, ``temperature[p]``, ``sigma_y0[p]`` (the flow stress at rest
-    sigma_y(eps_p[p], 0, temperature[p]), kept by :func:`rest_flow_stresses`), ``deps_last[p]``
-    (the particle's plastic strain increment on its last plastic step, 0 before it first flowed:
-    the return map's starting guess), the packed rows ``prm_a``/``prm_b`` with volume fraction
-    ``frac_a`` of a, ``rate_scale`` (v_experiment / v_simulation) and the Taylor-Quinney factor.
-    Writes: ``stress[p]`` (new Cauchy stress), ``eps_p[p] += deps_p``, ``temperature[p] +=
-    taylor_quinney * w / (rho cp)`` and, when it flowed, ``sigma_y0[p]`` at the new plastic strain
-    and temperature and ``deps_last[p] = deps_p``.
+    Reads, of the particles ``P`` (:class:`plough.mpm.particles.Particles`): ``P.stress[p]`` ((n, 6) Voigt
+    xx, yy, zz, yz, xz, xy; only its deviator is used), ``P.J[p]`` (det F after this step: the caller
+    updates it first), ``P.eps_p[p]``, ``P.temperature[p]``, ``P.sigma_y0[p]`` (the flow stress at rest
+    sigma_y(eps_p[p], 0, temperature[p]), kept by :func:`rest_flow_stresses`), ``P.deps_last[p]`` (the
+    particle's plastic strain increment on its last plastic step, 0 before it first flowed: the return
+    map's starting guess) and its materials, the rows ``P.mat_a[p]``/``P.mat_b[p]`` of ``M.table`` with
+    volume fraction ``P.frac_a[p]`` of a; ``L`` ((3, 3) velocity gradient of the particle, L[i, j] =
+    dv_i/dx_j), ``dt``, and of the materials ``M`` (:class:`plough.mpm.bundles.MaterialData`)
+    ``M.rate_scale`` (v_experiment / v_simulation) and the Taylor-Quinney factor ``M.taylor_quinney``.
+    Writes: ``P.stress[p]`` (new Cauchy stress), ``P.eps_p[p] += deps_p``, ``P.temperature[p] +=
+    taylor_quinney * w / (rho cp)`` and, when it flowed, ``P.sigma_y0[p]`` at the new plastic strain
+    and temperature and ``P.deps_last[p] = deps_p``.
 
     Steps: K, G = Voigt mix of a and b; s = dev(stress[p]); s_trial = R s R^T + 2 G dt dev(sym L)
     with the Hughes-Winget rotation R = (I - dt/2 W)^-1 (I + dt/2 W), W = skew(L) (exactly
@@ -499,6 +499,9 @@ def update_stress(
     Returns ``(deps_p, w)``: the plastic strain increment and the plastic work density
     w = sigma_y deps_p (J/m^3 of current volume).
     """
+    stress, eps_p, temperature, sigma_y0, deps_last = P.stress, P.eps_p, P.temperature, P.sigma_y0, P.deps_last
+    prm_a, prm_b, frac_a, J = M.table[P.mat_a[p]], M.table[P.mat_b[p]], P.frac_a[p], P.J[p]
+    rate_scale, taylor_quinney = M.rate_scale, M.taylor_quinney
     K, G = mixed_moduli(prm_a, prm_b, frac_a)
 
     # deviatoric part of the old stress
@@ -615,50 +618,16 @@ def elastic_energy_density(stress, p, K, G):
 
 
 @njit(cache=True, parallel=True)
-def update_stresses(
-    stress,
-    L_all,
-    dt,
-    J,
-    eps_p,
-    temperature,
-    sigma_y0,
-    deps_last,
-    mat_a,
-    mat_b,
-    frac_a,
-    table,
-    rate_scale,
-    taylor_quinney,
-    deps_out,
-    work_out,
-):
-    """Parallel driver: :func:`update_stress` for every particle.
+def update_stresses(P, L_all, dt, M, deps_out, work_out):
+    """Parallel driver: :func:`update_stress` for every particle of ``P``.
 
-    Reads ``L_all`` (n, 3, 3), ``J`` (n,), ``mat_a``/``mat_b`` (n,) integer rows of ``table``
-    (packed materials), ``frac_a`` (n,). Updates ``stress`` (n, 6), ``eps_p`` (n,),
-    ``temperature`` (n,), ``sigma_y0`` (n,; the flow stress at rest, see :func:`rest_flow_stresses`)
-    and ``deps_last`` (n,; the last plastic increment) in place and writes ``deps_out[i]`` (plastic
-    strain increment) and ``work_out[i]`` (plastic work density, J/m^3).
+    Reads ``L_all`` (n, 3, 3) and what :func:`update_stress` reads; updates ``P.stress``, ``P.eps_p``,
+    ``P.temperature``, ``P.sigma_y0`` and ``P.deps_last`` in place and writes ``deps_out[i]`` (plastic
+    strain increment) and ``work_out[i]`` (plastic work density, J/m^3). Each particle writes only its
+    own entries: race-free.
     """
-    n = stress.shape[0]
-    for i in prange(n):
-        d, w = update_stress(
-            stress,
-            i,
-            L_all[i],
-            dt,
-            J[i],
-            eps_p,
-            temperature,
-            sigma_y0,
-            deps_last,
-            table[mat_a[i]],
-            table[mat_b[i]],
-            frac_a[i],
-            rate_scale,
-            taylor_quinney,
-        )
+    for i in prange(P.stress.shape[0]):
+        d, w = update_stress(P, i, L_all[i], dt, M)
         deps_out[i] = d
         work_out[i] = w
 

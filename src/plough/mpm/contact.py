@@ -51,7 +51,7 @@ import math
 from numba import njit
 
 from plough.mpm.grid import GHOST, MIRROR
-from plough.mpm.shape import bspline2, bspline2_grad
+from plough.mpm.shape import bspline2_grad, stencil, stencil_node
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
 SQRT3 = math.sqrt(3.0)
@@ -86,85 +86,68 @@ def _inside_box(origin, dx, shape, centre, radius):
     return lo[0], hi[0], lo[1], hi[1], lo[2], hi[2]
 
 
-@njit(cache=True, inline="always")
-def _pick(k, v0, v1, v2):
-    return v0 if k == 0 else (v1 if k == 1 else v2)
-
-
 @njit(cache=True)
-def scatter_contact_stress(x, stress, mass, vol0, J, sigma_y0, near, origin, dx, shape, centre, radius, mirror_j0, cbuf,
-                           p_lo, p_hi):
+def scatter_contact_stress(P, G, S, Z):
     """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
     sphere onto nearby nodes.
 
-    Reads particle x, stress, mass, vol0, J, the flow stress at rest ``sigma_y0`` (kappa = sigma_y0 /
-    sqrt 3, the shear strength) and ``near`` (set by g2p) of the active particles p_lo <= p < p_hi.
-    For nodes within one cell of the sphere surface (or inside it) writes
-    cbuf[node, 0:6] += w m sigma, cbuf[node, 6] += w m kappa, cbuf[node, 7] += w m,
-    cbuf[node, 8] = max(cbuf[node, 8], dx - gap) over its particles (gap = distance from the
+    Reads P.x, stress, mass, vol0, J, the flow stress at rest ``P.sigma_y0`` (kappa = sigma_y0 /
+    sqrt 3, the shear strength) and ``P.near`` (set by g2p) of the active particles Z.p_lo <= p < Z.p_hi,
+    and the sphere's S.centre and S.radius. For nodes within one cell of the sphere surface (or inside
+    it) writes G.cbuf[node, 0:6] += w m sigma, G.cbuf[node, 6] += w m kappa, G.cbuf[node, 7] += w m,
+    G.cbuf[node, 8] = max(G.cbuf[node, 8], dx - gap) over its particles (gap = distance from the
     particle's face, half a particle size from its centre, to the sphere surface) and
-    cbuf[node, C_AREA:C_AREA + 3] += V grad w (the node's share of the material's surface, as a
-    vector). With the mirror plane (``mirror_j0`` >= 0, else -1) the surface vector of a ghost node
+    G.cbuf[node, C_AREA:C_AREA + 3] += V grad w (the node's share of the material's surface, as a
+    vector). With the mirror plane (``G.mirror_j0`` >= 0, else -1) the surface vector of a ghost node
     (y < 0) goes to its partner with its y component reversed: the mirrored particles' share.
     Serial: few particles are near the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
-    Only particles flagged ``near`` (within ``near_dist`` = 3 dx of the sphere, set by g2p) are
+    Only particles flagged ``near`` (within ``S.near_dist`` = 3 dx of the sphere, set by g2p) are
     scattered; a node at the edge of the reach (r + dx) has stencil particles out to about r + 3.6 dx,
     so its sums miss the farthest corner particles (weights of order 1e-3): a small approximation.
     """
-    ny, nz = shape[1], shape[2]
+    x, stress, mass, near, cbuf, mirror_j0 = P.x, P.stress, P.mass, P.near, G.cbuf, G.mirror_j0
+    origin, dx, centre, radius = G.origin, G.dx, S.centre, S.radius
+    ny, nz = G.shape[1], G.shape[2]
     inv_dx = 1.0 / dx
     reach2 = (radius + dx) * (radius + dx)
-    for p in range(p_lo, p_hi):
+    for p in range(Z.p_lo, Z.p_hi):
         if near[p] == 0:
             continue
         q0 = x[p, 0] - centre[0]
         q1 = x[p, 1] - centre[1]
         q2 = x[p, 2] - centre[2]
-        vol = vol0[p] * J[p]
+        vol = P.vol0[p] * P.J[p]
         # proximity dx - gap of the particle's face to the sphere surface (> 0 within one cell)
         prox = dx - (math.sqrt(q0 * q0 + q1 * q1 + q2 * q2) - radius - 0.5 * vol ** (1.0 / 3.0))
-        kappa = sigma_y0[p] / SQRT3
-        gx = (x[p, 0] - origin[0]) * inv_dx
-        gy = (x[p, 1] - origin[1]) * inv_dx
-        gz = (x[p, 2] - origin[2]) * inv_dx
-        bx, wx0, wx1, wx2 = bspline2(gx)
-        by, wy0, wy1, wy2 = bspline2(gy)
-        bz, wz0, wz1, wz2 = bspline2(gz)
-        _, dwx0, dwx1, dwx2 = bspline2_grad(gx)
-        _, dwy0, dwy1, dwy2 = bspline2_grad(gy)
-        _, dwz0, dwz1, dwz2 = bspline2_grad(gz)
+        kappa = P.sigma_y0[p] / SQRT3
+        st = stencil(x, p, origin, inv_dx)
+        dwx, dwy, dwz = bspline2_grad(st.g[0])[1:], bspline2_grad(st.g[1])[1:], bspline2_grad(st.g[2])[1:]
         v_dx = vol * inv_dx  # V grad w, with the derivatives in grid units
         for a in range(3):
-            wa = _pick(a, wx0, wx1, wx2)
-            da = _pick(a, dwx0, dwx1, dwx2)
-            px = origin[0] + (bx + a) * dx - centre[0]
+            px = origin[0] + (st.base[0] + a) * dx - centre[0]
             for b in range(3):
-                wb = _pick(b, wy0, wy1, wy2)
-                db = _pick(b, dwy0, dwy1, dwy2)
-                py = origin[1] + (by + b) * dx - centre[1]
+                py = origin[1] + (st.base[1] + b) * dx - centre[1]
                 for cc in range(3):
-                    pz = origin[2] + (bz + cc) * dx - centre[2]
+                    pz = origin[2] + (st.base[2] + cc) * dx - centre[2]
                     if px * px + py * py + pz * pz >= reach2:
                         continue
-                    wc = _pick(cc, wz0, wz1, wz2)
-                    dc = _pick(cc, dwz0, dwz1, dwz2)
-                    wm = wa * wb * wc * mass[p]
-                    node = ((bx + a) * ny + (by + b)) * nz + bz + cc
+                    node, w = stencil_node(st, a, b, cc, ny, nz)
+                    wm = w * mass[p]
                     for k in range(6):
                         cbuf[node, k] += wm * stress[p, k]
                     cbuf[node, 6] += wm * kappa
                     cbuf[node, 7] += wm
                     if prox > cbuf[node, 8]:
                         cbuf[node, 8] = prox
-                    s1 = v_dx * wa * db * wc
-                    j = by + b
+                    s1 = v_dx * st.wx[a] * dwy[b] * st.wz[cc]
+                    j = st.base[1] + b
                     if mirror_j0 >= 0 and j < mirror_j0:
                         j = 2 * mirror_j0 - j
                         s1 = -s1
-                    target = ((bx + a) * ny + j) * nz + bz + cc
-                    cbuf[target, C_AREA] += v_dx * da * wb * wc
+                    target = ((st.base[0] + a) * ny + j) * nz + st.base[2] + cc
+                    cbuf[target, C_AREA] += v_dx * dwx[a] * st.wy[b] * st.wz[cc]
                     cbuf[target, C_AREA + 1] += s1
-                    cbuf[target, C_AREA + 2] += v_dx * wa * wb * dc
+                    cbuf[target, C_AREA + 2] += v_dx * st.wx[a] * st.wy[b] * dwz[cc]
 
 
 @njit(cache=True)
@@ -193,21 +176,24 @@ def surface_share(cbuf, node, mirror_plane):
 
 
 @njit(cache=True)
-def sphere_contact(grid_m, grid_v, cbuf, flags, last_push, step, hold_steps, origin, dx, shape, centre, radius,
-                   v_sphere, dt, model, iparams, out):
+def sphere_contact(G, S, law, step, dt, out):
     """Impose the sphere on the nodes inside it and measure the reaction.
 
-    Reads grid_m, cbuf (from scatter_contact_stress; its entries are zeroed here). Reads and
-    writes the per-node contact memory last_push (the step a node's velocity was last cut by the
-    normal projection): a node pushed now, or within the last ``hold_steps`` steps, is in contact
-    and carries interface shear. Writes grid_v of contact nodes and out[0:N_OUT] (see the OUT_*
-    indices). It works on the nodes around the sphere whatever the active zone: nodes outside the
-    zone's range have no mass and are skipped. A clamped node the sphere pushed would take the
-    sphere's velocity; this is not excluded here: behind the sphere it moves away from the material
-    (no push), and ahead the zone's end lies at least 2 expected contact radii and 20 h from the
-    centre (over the workflow's runs the sphere's surface there is at least 5.6 um above the
-    expected groove depth, about one contact reach at h = 2.5 um; README, "Active zone").
+    Reads G.m, G.flags, G.cbuf (from scatter_contact_stress; its entries are zeroed here), the sphere
+    (S.centre, S.radius, S.velocity) and the interface law (``law``,
+    :class:`plough.mpm.bundles.ContactLaw`). Reads and writes the per-node contact memory G.last_push
+    (the step a node's velocity was last cut by the normal projection): a node pushed at ``step``, or
+    within the last ``law.hold_steps`` steps, is in contact and carries interface shear. Writes G.v of
+    contact nodes and out[0:N_OUT] (see the OUT_* indices). Serial: it visits only the box of nodes
+    around the sphere. It works on them whatever the active zone: nodes outside the zone's range have no
+    mass and are skipped. A clamped node the sphere pushed would take the sphere's velocity; this is not
+    excluded here: behind the sphere it moves away from the material (no push), and ahead the zone's end
+    lies at least 2 expected contact radii and 20 h from the centre (over the workflow's runs the
+    sphere's surface there is at least 5.6 um above the expected groove depth, about one contact reach
+    at h = 2.5 um; README, "Active zone").
     """
+    grid_m, grid_v, cbuf, flags, last_push = G.m, G.v, G.cbuf, G.flags, G.last_push
+    origin, dx, shape, centre, radius, v_sphere = G.origin, G.dx, G.shape, S.centre, S.radius, S.velocity
     ny, nz = shape[1], shape[2]
     for k in range(N_OUT):
         out[k] = 0.0
@@ -243,7 +229,7 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, last_push, step, hold_steps, ori
                 dist = math.sqrt(d2)
                 if m <= 0.0 or prox <= 0.0 or flags[node] == GHOST or dist <= 0.0:
                     continue  # ghosts (y < 0) mirror their partners: their impulse is not the body's
-                held = step - last_push[node] <= hold_steps
+                held = step - last_push[node] <= law.hold_steps
                 gap = max(dx - prox, 0.0)  # of the node's closest particle face
                 n0 = px / dist
                 n1 = py / dist
@@ -274,7 +260,7 @@ def sphere_contact(grid_m, grid_v, cbuf, flags, last_push, step, hold_steps, ori
                     pressure = 0.0
                     kappa = 0.0
                 vn_after = max(vn, vn_min)
-                tau = interface_shear(model, iparams, pressure, kappa)
+                tau = interface_shear(law.model, law.params, pressure, kappa)
                 jt = 0.0
                 if vt > 0.0:
                     jt = min(m * vt, tau * area * dt)

@@ -18,7 +18,7 @@ particle's edge is ``cbrt(vol0)``; nothing downstream assumes h.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
@@ -26,8 +26,10 @@ from plough.mpm.constitutive import I_RHO, rest_flow_stresses
 from plough.mpm.scene import FINE_ZONE_SHAPES, Scene
 
 
-@dataclass
-class Particles:
+class Particles(NamedTuple):
+    """The particles' state, one row per particle: the kernels' particle bundle ``P``
+    (:mod:`plough.mpm.bundles`); the arrays are updated in place, never replaced."""
+
     x: np.ndarray  # (n, 3) position, m
     v: np.ndarray  # (n, 3) velocity, m/s
     C: np.ndarray  # (n, 3, 3) APIC affine matrix = velocity gradient, 1/s
@@ -182,3 +184,18 @@ def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float,
     vol = np.concatenate([np.full(keep.shape[0], h**3), np.full(merged.shape[0], 8.0 * h**3)])
     order = np.lexsort((xs[:, 2], xs[:, 1], xs[:, 0]))
     return xs[order], vol[order]
+
+
+def particles_of(n: int, **arrays: np.ndarray) -> Particles:
+    """``n`` particles with the given arrays and, for the rest, particles at rest at the origin: unit volume,
+    mass and J, no stress, no plastic strain, at 298 K, of material row 0 alone (for kernels called on
+    their own: tests and benchmarks)."""
+    unknown = set(arrays) - set(Particles._fields)
+    if unknown:
+        raise ValueError(f"particles_of: {sorted(unknown)} are not fields of Particles ({list(Particles._fields)})")
+    default = {"x": np.zeros((n, 3)), "v": np.zeros((n, 3)), "C": np.zeros((n, 3, 3)), "stress": np.zeros((n, 6)),
+               "J": np.ones(n), "vol0": np.ones(n), "mass": np.ones(n), "eps_p": np.zeros(n),
+               "temperature": np.full(n, 298.0), "sigma_y0": np.zeros(n), "deps_last": np.zeros(n),
+               "mat_a": np.zeros(n, dtype=np.int32), "mat_b": np.zeros(n, dtype=np.int32), "frac_a": np.ones(n),
+               "near": np.zeros(n, dtype=np.int8), "z0": np.zeros(n)}
+    return Particles(**{**default, **arrays})

@@ -322,6 +322,6 @@ def warm_up(threads: int | None = None) -> float:
 
 def _compile_freeze(table: np.ndarray) -> None:
     """Compile the active zone's freezing kernel, which the warm-up scene (no zone) never calls."""
-    one = np.zeros((1, 3))
-    transfers.freeze_particles(0, 1, one.copy(), np.zeros((1, 3, 3)), one.copy(), np.zeros((1, 6)), np.ones(1),
-                               np.ones(1), np.ones(1), np.zeros(1, np.int32), np.zeros(1, np.int32), np.ones(1), table)
+    from plough.mpm.particles import particles_of
+
+    transfers.freeze_particles(particles_of(1), np.zeros((1, 3)), table, 0, 1)

@@ -9,11 +9,16 @@ base = floor(x - 0.5), fx = x - base in [0.5, 1.5):
 
 and the derivatives with respect to x are fx - 1.5, -2 (fx - 1), fx - 0.5. The weights sum
 to 1 and reproduce linear functions exactly; the APIC/MLS inertia matrix is D = dx^2/4 I.
+
+A particle's stencil (:func:`stencil`) is set up here once for every kernel that visits its 27
+nodes (the transfers and the contact): node (a, b, c), each 0..2, has the flat index
+:func:`stencil_node` gives and the weight wx[a] wy[b] wz[c].
 """
 
 from __future__ import annotations
 
 import math
+from typing import NamedTuple
 
 from numba import njit
 
@@ -35,3 +40,44 @@ def bspline2_grad(x):
     base = int(math.floor(x - 0.5))
     fx = x - base
     return base, fx - 1.5, -2.0 * (fx - 1.0), fx - 0.5
+
+
+class Stencil(NamedTuple):
+    """The 27 nodes around a particle: the lowest node's (i, j, k), the particle's position in grid units
+    from the grid's origin, and the three weights along each axis."""
+
+    base: tuple[int, int, int]
+    g: tuple[float, float, float]
+    wx: tuple[float, float, float]
+    wy: tuple[float, float, float]
+    wz: tuple[float, float, float]
+
+
+@njit(cache=True, inline="always")
+def stencil(x, p, origin, inv_dx):
+    """The stencil of particle p at x[p] on the grid of origin ``origin`` and cell size 1 / ``inv_dx``."""
+    gx = (x[p, 0] - origin[0]) * inv_dx
+    gy = (x[p, 1] - origin[1]) * inv_dx
+    gz = (x[p, 2] - origin[2]) * inv_dx
+    bx, wx0, wx1, wx2 = bspline2(gx)
+    by, wy0, wy1, wy2 = bspline2(gy)
+    bz, wz0, wz1, wz2 = bspline2(gz)
+    return Stencil((bx, by, bz), (gx, gy, gz), (wx0, wx1, wx2), (wy0, wy1, wy2), (wz0, wz1, wz2))
+
+
+@njit(cache=True, inline="always")
+def stencil_row(s, a, b, ny, nz):
+    """Flat index of the stencil's node (a, b, 0) on a grid of ny x nz nodes per x slab (z fastest)."""
+    return ((s.base[0] + a) * ny + (s.base[1] + b)) * nz + s.base[2]
+
+
+@njit(cache=True, inline="always")
+def stencil_node(s, a, b, c, ny, nz):
+    """Flat index and weight wx[a] wy[b] wz[c] of the stencil's node (a, b, c)."""
+    return stencil_row(s, a, b, ny, nz) + c, s.wx[a] * s.wy[b] * s.wz[c]
+
+
+@njit(cache=True, inline="always")
+def stencil_offset(s, a, b, c, dx):
+    """x_i - x_p of the stencil's node (a, b, c), m, on a grid of cell size ``dx``."""
+    return (s.base[0] + a - s.g[0]) * dx, (s.base[1] + b - s.g[1]) * dx, (s.base[2] + c - s.g[2]) * dx

@@ -43,6 +43,7 @@ from plough.materials import (
     ProportionalShear,
 )
 from plough.mpm import contact, transfers
+from plough.mpm.bundles import ContactLaw, GridData, MaterialData, SphereData, Zone
 from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
 from plough.mpm.grid import Grid, boundary_flags, extend_node_array, grown, make_grid, mirror_plane_index
 from plough.mpm.particles import Particles, seed_particles, uniform_particle_count
@@ -149,6 +150,16 @@ class Constants:
     block_end_m: float = 0.0  # m, x of the block's far end face (the grid starts a few cells past it)
     block_side_m: float = 0.0  # m, y of the block's side face, its radius R (the grid starts a few cells past it)
 
+    @property
+    def material(self) -> MaterialData:
+        """The materials bundle ``M`` the stress update takes."""
+        return MaterialData(table=self.table, rate_scale=self.rate_scale, taylor_quinney=self.taylor_quinney)
+
+    @property
+    def contact_law(self) -> ContactLaw:
+        """The interface law and the contact's hold, as ``sphere_contact`` takes them."""
+        return ContactLaw(model=self.interface_model, params=self.interface_params, hold_steps=self.contact_hold_steps)
+
 
 @dataclass
 class ActiveZone:
@@ -171,6 +182,11 @@ class ActiveZone:
     check_hi_m: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
     frozen_elastic_J: float = 0.0
     frozen_kinetic_loss_J: float = 0.0
+
+    def ranges(self) -> Zone:
+        """The zone bundle ``Z`` the kernels take (its check box arrays are this zone's own)."""
+        return Zone(p_lo=self.p_lo, p_hi=self.p_hi, n_lo=self.n_lo, n_hi=self.n_hi, i_free_lo=self.i_free_lo,
+                    i_free_hi=self.i_free_hi, check_lo=self.check_lo_m, check_hi=self.check_hi_m)
 
 
 @dataclass
@@ -342,36 +358,41 @@ def contact_stiffness(scene: Scene, contact_radius: float) -> float:
 
 # ----------------------------------------------------------------------------- one step
 def step(s: State, c: Constants) -> None:
-    """Advance the state by one time step dt."""
-    p, w, sph, z = s.particles, s.work, s.sphere, s.zone
-    g = c.grid
+    """Advance the state by one time step dt (the module docstring's steps 1-5; the kernels' bundles:
+    :mod:`plough.mpm.bundles`)."""
     update_active_zone(s, c)
-    transfers.p2g(p.x, p.v, p.C, p.stress, p.vol0, p.J, p.mass, g.origin, g.dx, c.dt, c.shape, w.grid_buf,
-                  z.p_lo, z.p_hi, z.n_lo, z.n_hi)
-    transfers.grid_update(w.grid_buf, w.flags, w.grid_m, w.grid_v, c.shape, c.mirror_j0, z.n_lo, z.n_hi,
-                          z.i_free_lo, z.i_free_hi)
-    contact.scatter_contact_stress(p.x, p.stress, p.mass, p.vol0, p.J, p.sigma_y0, p.near, g.origin, g.dx, c.shape,
-                                   sph.centre, c.sphere_radius, c.mirror_j0, w.cbuf, z.p_lo, z.p_hi)
-    contact.sphere_contact(w.grid_m, w.grid_v, w.cbuf, w.flags, w.last_push, s.step, c.contact_hold_steps, g.origin,
-                           g.dx, c.shape, sph.centre, c.sphere_radius, sph.velocity, c.dt, c.interface_model,
-                           c.interface_params, w.contact_out)
-    if c.mirror_j0 >= 0:
-        transfers.mirror_ghosts(w.grid_v, w.flags, c.shape, c.mirror_j0, z.n_lo, z.n_hi)
-    move_sphere(sph, c)
-    transfers.g2p_kinematics(w.grid_v, g.origin, g.dx, c.shape, p.x, p.v, p.C, w.v_grid, p.mass, c.flip, w.grid_buf,
-                             c.project_dilatation, z.p_lo, z.p_hi, z.n_lo, z.n_hi)
+    P, G, S, Z, w = s.particles, grid_data(s, c), sphere_data(s, c), s.zone.ranges(), s.work
+    transfers.p2g(P, G, c.dt, Z)  # 1. P2G
+    transfers.grid_update(G, Z)  # 2. grid velocities, boundary conditions
+    contact.scatter_contact_stress(P, G, S, Z)  # 3. contact: the near particles' stress on the nodes,
+    contact.sphere_contact(G, S, c.contact_law, s.step, c.dt, w.contact_out)  # the sphere on the nodes
+    if G.mirror_j0 >= 0:
+        transfers.mirror_ghosts(G, Z)
+    move_sphere(s.sphere, c)  # 4. sphere motion
+    transfers.g2p_kinematics(P, G, w.v_grid, c.flip, c.project_dilatation, Z)  # 5. G2P: velocities,
     if c.project_dilatation:
-        transfers.grid_dilatation(w.grid_buf, w.grid_div, c.shape, c.mirror_j0, z.n_lo, z.n_hi)
-    transfers.g2p_update(g.origin, g.dx, c.dt, c.shape, p.x, p.v, w.v_grid, p.C, p.stress, p.J, p.vol0, p.mass,
-                         p.eps_p, p.temperature, p.sigma_y0, p.deps_last, p.mat_a, p.mat_b, p.frac_a, c.table,
-                         c.rate_scale, c.taylor_quinney, sph.centre, c.sphere_radius, c.near_dist, p.near, w.acc,
-                         z.check_lo_m, z.check_hi_m, w.grid_div, c.project_dilatation, w.L_buf, z.p_lo, z.p_hi,
-                         transfers.G2P_BLOCK)
+        transfers.grid_dilatation(G, Z)  # the projected dilatation,
+    transfers.g2p_update(P, G, c.material, S, Z, c.dt, c.project_dilatation, w.v_grid, w.L_buf, w.acc,
+                         transfers.G2P_BLOCK)  # the stress update and advection
     account_energy(w)
     check_stability(s, c)
-    control_sphere(sph, c.symmetry_factor * reaction_z(w), c)
+    control_sphere(s.sphere, c.symmetry_factor * reaction_z(w), c)
     s.step += 1
     s.time += c.dt
+
+
+def grid_data(s: State, c: Constants) -> GridData:
+    """The grid bundle ``G`` of this step: the grid's geometry and the work's per-node arrays (both change
+    when the grid grows)."""
+    w = s.work
+    return GridData(origin=c.grid.origin, dx=c.grid.dx, shape=c.shape, mirror_j0=c.mirror_j0, flags=w.flags,
+                    buf=w.grid_buf, m=w.grid_m, v=w.grid_v, div=w.grid_div, cbuf=w.cbuf, last_push=w.last_push)
+
+
+def sphere_data(s: State, c: Constants) -> SphereData:
+    """The sphere bundle ``S``: the state's centre and velocity (moved in place), the run's radius and reach."""
+    return SphereData(centre=s.sphere.centre, velocity=s.sphere.velocity, radius=c.sphere_radius,
+                      near_dist=c.near_dist)
 
 
 def update_active_zone(s: State, c: Constants) -> None:
@@ -391,8 +412,7 @@ def update_active_zone(s: State, c: Constants) -> None:
     p_lo = max(z.p_lo, int(np.searchsorted(c.zone_x0_m, lo_x, side="left")))
     p_hi = max(z.p_hi, int(np.searchsorted(c.zone_x0_m, hi_x, side="right")))
     if p_lo > z.p_lo:
-        elastic, kinetic = transfers.freeze_particles(z.p_lo, p_lo, p.v, p.C, w.v_grid, p.stress, p.J, p.vol0, p.mass,
-                                                      p.mat_a, p.mat_b, p.frac_a, c.table)
+        elastic, kinetic = transfers.freeze_particles(p, w.v_grid, c.table, z.p_lo, p_lo)
         z.frozen_elastic_J += elastic
         z.frozen_kinetic_loss_J += kinetic
     n = c.zone_x0_m.size
@@ -726,7 +746,9 @@ def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
 
 
 def _array_bytes(obj: object) -> int:
-    return sum(v.nbytes for v in vars(obj).values() if isinstance(v, np.ndarray))
+    """Bytes of the arrays a dataclass or a named tuple (the particles) holds."""
+    values = obj._asdict().values() if hasattr(obj, "_asdict") else vars(obj).values()
+    return sum(v.nbytes for v in values if isinstance(v, np.ndarray))
 
 
 def raise_bytes(s: State, shape: tuple[int, int, int], extra: int, axis: int = 2) -> int:

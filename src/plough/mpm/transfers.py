@@ -33,10 +33,10 @@ Threads: P2G and the kinematics cut the particles into ``n_chunks`` contiguous c
 order, so a chunk is a slab of the block); ``g2p_update``, whose cost per particle varies (a
 plastic particle's return map costs several flow-law evaluations, and they cluster around the
 sphere), deals blocks of ``G2P_BLOCK`` particles to the chunks in turn. The scatter is race-free
-by construction: chunk c writes only its own grid copy ``grid_buf[c]``; the grid update sums the
+by construction: chunk c writes only its own grid copy ``G.buf[c]``; the grid update sums the
 copies node by node (each node owned by one iteration). The gathers read the grid and write only
 particle p's own entries; the dilatation scatter inside ``g2p_kinematics`` writes only its
-chunk's ``grid_buf[c]`` and ``g2p_update`` only its chunk's scratch ``L_buf[c]``.
+chunk's ``G.buf[c]`` and ``g2p_update`` only its chunk's scratch ``L_buf[c]``.
 """
 
 from __future__ import annotations
@@ -48,7 +48,7 @@ from numba import njit, prange
 
 from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
 from plough.mpm.grid import FIXED, GHOST, MIRROR
-from plough.mpm.shape import APIC_D_INV_FACTOR, bspline2
+from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_node, stencil_offset, stencil_row
 
 # per-chunk accumulators written by g2p_update
 ACC_PLASTIC_WORK = 0
@@ -68,22 +68,24 @@ G2P_BLOCK = 1024
 
 
 @njit(cache=True, parallel=True)
-def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf, p_lo, p_hi, n_lo, n_hi):
+def p2g(P, G, dt, Z):
     """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
 
-    Reads x, v, C, stress, vol0, J, mass of the active particles p_lo <= p < p_hi. Writes
-    grid_buf[c, node, 0:7] = (mass, momentum x, y, z, and the internal-force impulse x, y, z
-    already in that momentum) of chunk c, zeroing the active nodes n_lo <= node < n_hi first.
-    Race-free: chunk c owns grid_buf[c].
+    Reads P.x, v, C, stress, vol0, J, mass of the active particles Z.p_lo <= p < Z.p_hi and the grid's
+    geometry. Writes G.buf[c, node, 0:7] = (mass, momentum x, y, z, and the internal-force impulse x,
+    y, z already in that momentum) of chunk c, zeroing the active nodes Z.n_lo <= node < Z.n_hi first.
+    Race-free: chunk c owns G.buf[c].
     """
+    x, v, C, stress, vol0, J, mass = P.x, P.v, P.C, P.stress, P.vol0, P.J, P.mass
+    p_lo, p_hi = Z.p_lo, Z.p_hi
     n = p_hi - p_lo
-    n_chunks = grid_buf.shape[0]
-    ny, nz = shape[1], shape[2]
-    inv_dx = 1.0 / dx
+    n_chunks = G.buf.shape[0]
+    ny, nz = G.shape[1], G.shape[2]
+    inv_dx = 1.0 / G.dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
-        buf = grid_buf[c]
-        buf[n_lo:n_hi, :] = 0.0
+        buf = G.buf[c]
+        buf[Z.n_lo:Z.n_hi, :] = 0.0
         for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             m = mass[p]
             k_stress = -dt * vol0[p] * J[p] * dinv
@@ -99,23 +101,12 @@ def p2g(x, v, C, stress, vol0, J, mass, origin, dx, dt, shape, grid_buf, p_lo, p
             q01 = m * C[p, 0, 1] + k_stress * s[5]
             q10 = m * C[p, 1, 0] + k_stress * s[5]
             mv0, mv1, mv2 = m * v[p, 0], m * v[p, 1], m * v[p, 2]
-            gx = (x[p, 0] - origin[0]) * inv_dx
-            gy = (x[p, 1] - origin[1]) * inv_dx
-            gz = (x[p, 2] - origin[2]) * inv_dx
-            bx, wx0, wx1, wx2 = bspline2(gx)
-            by, wy0, wy1, wy2 = bspline2(gy)
-            bz, wz0, wz1, wz2 = bspline2(gz)
+            st = stencil(x, p, G.origin, inv_dx)
             for a in range(3):
-                wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
-                d0 = (bx + a - gx) * dx
                 for b in range(3):
-                    wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
-                    d1 = (by + b - gy) * dx
-                    row = ((bx + a) * ny + (by + b)) * nz + bz
                     for cc in range(3):
-                        w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
-                        d2 = (bz + cc - gz) * dx
-                        node = row + cc
+                        node, w = stencil_node(st, a, b, cc, ny, nz)
+                        d0, d1, d2 = stencil_offset(st, a, b, cc, G.dx)
                         buf[node, 0] += w * m
                         buf[node, 1] += w * (mv0 + q00 * d0 + q01 * d1 + q02 * d2)
                         buf[node, 2] += w * (mv1 + q10 * d0 + q11 * d1 + q12 * d2)
@@ -138,14 +129,14 @@ def _mirror_partner(node, ny, nz, mirror_j0):
 
 
 @njit(cache=True, parallel=True)
-def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0, n_lo, n_hi, i_free_lo, i_free_hi):
+def grid_update(G, Z):
     """Sum the chunk copies into nodal mass and velocity and apply the boundary conditions.
 
-    Reads grid_buf (P2G output), flags (FREE / FIXED / MIRROR / GHOST), the grid shape and the
-    index ``mirror_j0`` of the node plane y = 0 (-1 without symmetry), for the active nodes
-    n_lo <= node < n_hi. Writes their grid_m[node], grid_v[node, 0:3] (velocity at the end of
-    the step before contact) and grid_v[node, 3:6] (velocity before the internal force, for the
-    FLIP increment). Nodes of x index outside [i_free_lo, i_free_hi] lie in the frozen material
+    Reads G.buf (P2G output), G.flags (FREE / FIXED / MIRROR / GHOST), the grid shape and the
+    index ``G.mirror_j0`` of the node plane y = 0 (-1 without symmetry), for the active nodes
+    Z.n_lo <= node < Z.n_hi. Writes their G.m[node], G.v[node, 0:3] (velocity at the end of
+    the step before contact) and G.v[node, 3:6] (velocity before the internal force, for the
+    FLIP increment). Nodes of x index outside [Z.i_free_lo, Z.i_free_hi] lie in the frozen material
     beyond the active zone and hold zero velocity, as FIXED nodes do. Each node is owned by one
     iteration and only reads the buffers, so the reduction is race-free.
 
@@ -155,9 +146,11 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0, n_lo, n_hi, i
     sum). A half domain then reproduces the full domain's grid state to round-off. Nodes on the
     plane keep their own (half) mass with v_y = 0, so impulses there are the half body's share.
     """
+    grid_buf, flags, grid_m, grid_v, mirror_j0 = G.buf, G.flags, G.m, G.v, G.mirror_j0
+    i_free_lo, i_free_hi = Z.i_free_lo, Z.i_free_hi
     n_chunks = grid_buf.shape[0]
-    ny, nz = shape[1], shape[2]
-    for node in prange(n_lo, n_hi):
+    ny, nz = G.shape[1], G.shape[2]
+    for node in prange(Z.n_lo, Z.n_hi):
         m = 0.0
         p0 = 0.0
         p1 = 0.0
@@ -204,14 +197,15 @@ def grid_update(grid_buf, flags, grid_m, grid_v, shape, mirror_j0, n_lo, n_hi, i
 
 
 @njit(cache=True, parallel=True)
-def mirror_ghosts(grid_v, flags, shape, mirror_j0, n_lo, n_hi):
+def mirror_ghosts(G, Z):
     """Ghost nodes (y < 0) take the mirror image of their partner's velocity after contact.
 
-    Reads grid_v of nodes with y > 0; writes grid_v of the GHOST nodes among n_lo <= node < n_hi
-    (each written once; a partner lies in its ghost's x slab, so in the same range).
+    Reads G.v of nodes with y > 0 and G.flags; writes G.v of the GHOST nodes among Z.n_lo <= node <
+    Z.n_hi (each written once; a partner lies in its ghost's x slab, so in the same range).
     """
-    ny, nz = shape[1], shape[2]
-    for node in prange(n_lo, n_hi):
+    grid_v, flags, mirror_j0 = G.v, G.flags, G.mirror_j0
+    ny, nz = G.shape[1], G.shape[2]
+    for node in prange(Z.n_lo, Z.n_hi):
         if flags[node] != GHOST:
             continue
         j = (node // nz) % ny
@@ -225,18 +219,19 @@ def mirror_ghosts(grid_v, flags, shape, mirror_j0, n_lo, n_hi):
 
 
 @njit(cache=True, parallel=True)
-def grid_dilatation(grid_buf, grid_div, shape, mirror_j0, n_lo, n_hi):
+def grid_dilatation(G, Z):
     """Nodal dilatation rate d_i = (sum w m d) / m_i from the chunk copies of the ``g2p_kinematics`` scatter.
 
-    Reads grid_buf[:, node, 0:2] of the active nodes n_lo <= node < n_hi; writes their
-    grid_div[node] (0 where no mass). With the mirror plane a
+    Reads G.buf[:, node, 0:2] of the active nodes Z.n_lo <= node < Z.n_hi; writes their
+    G.div[node] (0 where no mass). With the mirror plane a
     node also sums its ghost's contributions (the dilatation is even in y), so ghost and partner
     hold the same value and the half domain projects like the full one. Each node is owned by one
     iteration: race-free.
     """
+    grid_buf, grid_div, mirror_j0 = G.buf, G.div, G.mirror_j0
     n_chunks = grid_buf.shape[0]
-    ny, nz = shape[1], shape[2]
-    for node in prange(n_lo, n_hi):
+    ny, nz = G.shape[1], G.shape[2]
+    for node in prange(Z.n_lo, Z.n_hi):
         m = 0.0
         t = 0.0
         for c in range(n_chunks):
@@ -251,36 +246,32 @@ def grid_dilatation(grid_buf, grid_div, shape, mirror_j0, n_lo, n_hi):
 
 
 @njit(cache=True, parallel=True)
-def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_buf, scatter_dilatation, p_lo, p_hi,
-                   n_lo, n_hi):
+def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
     """Gather the particle velocities and velocity gradients; scatter the dilatation for its projection.
 
-    Reads grid_v (0:3 new, 3:6 before the internal force), x, v (FLIP share ``flip``) and mass
-    of the active particles p_lo <= p < p_hi. Writes their v (the blended update), C (= L_p, the
-    APIC velocity gradient) and v_grid (sum_i w v_i, the velocity the particle is advected with).
-    If ``scatter_dilatation`` is 1 also writes grid_buf[c, node, 0] = sum w m and
-    grid_buf[c, node, 1] = sum w m tr L over chunk c's particles (zeroing those two channels of
-    the active nodes n_lo <= node < n_hi first; the P2G content is no longer needed), for
+    Reads G.v (0:3 new, 3:6 before the internal force), P.x, P.v (FLIP share ``flip``) and P.mass
+    of the active particles Z.p_lo <= p < Z.p_hi. Writes their P.v (the blended update), P.C (= L_p,
+    the APIC velocity gradient) and v_grid (sum_i w v_i, the velocity the particle is advected with).
+    If ``scatter_dilatation`` is 1 also writes G.buf[c, node, 0] = sum w m and
+    G.buf[c, node, 1] = sum w m tr L over chunk c's particles (zeroing those two channels of
+    the active nodes Z.n_lo <= node < Z.n_hi first; the P2G content is no longer needed), for
     ``grid_dilatation``. The active particles' stencils must lie in the node range (the solver's
     positions check keeps them there). Race-free: particle p writes only its own entries, chunk c
-    only grid_buf[c].
+    only G.buf[c].
     """
+    x, v, C, mass, grid_v = P.x, P.v, P.C, P.mass, G.v
+    p_lo, p_hi = Z.p_lo, Z.p_hi
     n = p_hi - p_lo
-    n_chunks = grid_buf.shape[0]
-    ny, nz = shape[1], shape[2]
-    inv_dx = 1.0 / dx
+    n_chunks = G.buf.shape[0]
+    ny, nz = G.shape[1], G.shape[2]
+    inv_dx = 1.0 / G.dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
-        buf = grid_buf[c]
+        buf = G.buf[c]
         if scatter_dilatation:
-            buf[n_lo:n_hi, 0:2] = 0.0
+            buf[Z.n_lo:Z.n_hi, 0:2] = 0.0
         for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
-            gx = (x[p, 0] - origin[0]) * inv_dx
-            gy = (x[p, 1] - origin[1]) * inv_dx
-            gz = (x[p, 2] - origin[2]) * inv_dx
-            bx, wx0, wx1, wx2 = bspline2(gx)
-            by, wy0, wy1, wy2 = bspline2(gy)
-            bz, wz0, wz1, wz2 = bspline2(gz)
+            st = stencil(x, p, G.origin, inv_dx)
             v0 = 0.0
             v1 = 0.0
             v2 = 0.0
@@ -297,16 +288,10 @@ def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_
             b21 = 0.0
             b22 = 0.0
             for a in range(3):
-                wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
-                d0 = (bx + a - gx) * dx
                 for b in range(3):
-                    wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
-                    d1 = (by + b - gy) * dx
-                    row = ((bx + a) * ny + (by + b)) * nz + bz
                     for cc in range(3):
-                        w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
-                        d2 = (bz + cc - gz) * dx
-                        node = row + cc
+                        node, w = stencil_node(st, a, b, cc, ny, nz)
+                        d0, d1, d2 = stencil_offset(st, a, b, cc, G.dx)
                         gv0 = w * grid_v[node, 0]
                         gv1 = w * grid_v[node, 1]
                         gv2 = w * grid_v[node, 2]
@@ -345,34 +330,29 @@ def g2p_kinematics(grid_v, origin, dx, shape, x, v, C, v_grid, mass, flip, grid_
                 wm = mass[p]
                 wt = wm * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2])
                 for a in range(3):
-                    wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
                     for b in range(3):
-                        wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
-                        row = ((bx + a) * ny + (by + b)) * nz + bz
                         for cc in range(3):
-                            w = wab * (wz0 if cc == 0 else (wz1 if cc == 1 else wz2))
-                            buf[row + cc, 0] += w * wm
-                            buf[row + cc, 1] += w * wt
+                            node, w = stencil_node(st, a, b, cc, ny, nz)
+                            buf[node, 0] += w * wm
+                            buf[node, 1] += w * wt
 
 
 @njit(cache=True, parallel=True)
-def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, eps_p, temperature, sigma_y0, deps_last,
-               mat_a, mat_b, frac_a, table, rate_scale, taylor_quinney, sphere_c, sphere_r, near_dist, near, acc,
-               grid_lo, grid_hi, grid_div, project, L_buf, p_lo, p_hi, block):
+def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     """Update the stress (eq. 6.1-6.2), advect, and check the particle state.
 
-    Works on the active particles p_lo <= p < p_hi only. Reads particle v, v_grid and C (from
-    ``g2p_kinematics``), the sphere (centre sphere_c after this
-    step, radius sphere_r) and, if ``project`` is 1, the projected nodal dilatation grid_div
-    (``grid_dilatation``): J and the pressure then follow L_bar = C + (sum w d_i - tr C) I / 3,
-    formed in the chunk's scratch L_buf[c]; with ``project`` 0 they follow C (grid_div and L_buf
-    are not read). Writes particle x (x += dt v_grid), J, stress, eps_p, temperature, sigma_y0 and
-    deps_last (the flow stress at rest and the last plastic increment, updated where the particle
-    flowed), near (1 if
-    within near_dist of the sphere surface), and per-chunk accumulators acc[c, :] (plastic work,
-    kinetic and elastic energy, adiabatic heat, deepest penetration of a particle centre into the
-    sphere, worst instability code and the particle showing it). Each particle writes only its own
-    entries.
+    Works on the active particles Z.p_lo <= p < Z.p_hi only. Reads P.v and P.C (from
+    ``g2p_kinematics``), v_grid, P.vol0, P.mass, the materials (P.mat_a, mat_b, frac_a; the table and
+    constants M), the sphere (S.centre after this step, S.radius, S.near_dist) and, if ``project`` is
+    1, the projected nodal dilatation G.div (``grid_dilatation``): J and the pressure then follow
+    L_bar = C + (sum w d_i - tr C) I / 3, formed in the chunk's scratch L_buf[c]; with ``project`` 0
+    they follow C (G.div and L_buf are not read). Writes P.x (x += dt v_grid), J, stress, eps_p,
+    temperature, sigma_y0 and deps_last (the flow stress at rest and the last plastic increment,
+    updated where the particle flowed), P.near (1 if within S.near_dist of the sphere surface), and
+    per-chunk accumulators acc[c, :] (plastic work, kinetic and elastic energy, adiabatic heat,
+    deepest penetration of a particle centre into the sphere, worst instability code and the particle
+    showing it; a particle outside [Z.check_lo, Z.check_hi] has left the grid). Each particle writes
+    only its own entries, chunk c only acc[c] and L_buf[c]: race-free.
 
     Chunk c works on the blocks of ``block`` particles numbered c, c + n_chunks, c + 2 n_chunks, ...
     (``G2P_BLOCK`` in the solver), not on one contiguous slab: the particles that flow, whose return
@@ -381,10 +361,14 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
     halves on one thread, docs/journal/2026-11-23-g2p-load-balance.md). ``block`` = ceil(n / n_chunks) gives one
     contiguous slab per chunk (the earlier split, whose slab ends could lie one particle off).
     """
+    x, v, C, stress, J, vol0, mass, near = P.x, P.v, P.C, P.stress, P.J, P.vol0, P.mass, P.near
+    mat_a, mat_b, frac_a, table, taylor_quinney = P.mat_a, P.mat_b, P.frac_a, M.table, M.taylor_quinney
+    sphere_c, sphere_r, grid_lo, grid_hi = S.centre, S.radius, Z.check_lo, Z.check_hi
+    p_lo, p_hi = Z.p_lo, Z.p_hi
     n_chunks = acc.shape[0]
     n_blocks = (p_hi - p_lo + block - 1) // block
-    ny, nz = shape[1], shape[2]
-    inv_dx = 1.0 / dx
+    ny, nz = G.shape[1], G.shape[2]
+    inv_dx = 1.0 / G.dx
     for c in prange(n_chunks):
         wp_sum = 0.0
         ke_sum = 0.0
@@ -399,18 +383,15 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
                 L = Cp
                 if project:
                     L = L_buf[c]
-                    _with_dilatation(Cp, _gather_scalar(grid_div, x, p, origin, inv_dx, ny, nz), L)
+                    _with_dilatation(Cp, _gather_scalar(G.div, x, p, G.origin, inv_dx, ny, nz), L)
                 J_new = J[p] * _det_i_plus(dt, L)
                 J[p] = J_new
-                pa = table[mat_a[p]]
-                pb = table[mat_b[p]]
-                deps, w_pl = update_stress(stress, p, L, dt, J_new, eps_p, temperature, sigma_y0, deps_last, pa, pb,
-                                           frac_a[p], rate_scale, taylor_quinney)
+                deps, w_pl = update_stress(P, p, L, dt, M)
                 vol = vol0[p] * J_new
                 wp_sum += w_pl * vol
                 heat_sum += taylor_quinney * w_pl * vol
-                K, G = mixed_moduli(pa, pb, frac_a[p])
-                el_sum += elastic_energy_density(stress, p, K, G) * vol
+                K, G_shear = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
+                el_sum += elastic_energy_density(stress, p, K, G_shear) * vol
                 ke_sum += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
                 x0 = x[p, 0] + dt * v_grid[p, 0]
                 x1 = x[p, 1] + dt * v_grid[p, 1]
@@ -422,7 +403,7 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
                 r1 = x1 - sphere_c[1]
                 r2 = x2 - sphere_c[2]
                 dist = math.sqrt(r0 * r0 + r1 * r1 + r2 * r2)
-                near[p] = 1 if dist < sphere_r + near_dist else 0
+                near[p] = 1 if dist < sphere_r + S.near_dist else 0
                 if sphere_r - dist > pen_max:
                     pen_max = sphere_r - dist
                 # instability checks, worst code kept
@@ -449,16 +430,13 @@ def g2p_update(origin, dx, dt, shape, x, v, v_grid, C, stress, J, vol0, mass, ep
 @njit(cache=True, inline="always")
 def _gather_scalar(field, x, p, origin, inv_dx, ny, nz):
     """sum_i w_ip field[i] at particle p (quadratic B-spline weights)."""
-    bx, wx0, wx1, wx2 = bspline2((x[p, 0] - origin[0]) * inv_dx)
-    by, wy0, wy1, wy2 = bspline2((x[p, 1] - origin[1]) * inv_dx)
-    bz, wz0, wz1, wz2 = bspline2((x[p, 2] - origin[2]) * inv_dx)
+    st = stencil(x, p, origin, inv_dx)
     total = 0.0
     for a in range(3):
-        wa = wx0 if a == 0 else (wx1 if a == 1 else wx2)
         for b in range(3):
-            wab = wa * (wy0 if b == 0 else (wy1 if b == 1 else wy2))
-            row = ((bx + a) * ny + (by + b)) * nz + bz
-            total += wab * (wz0 * field[row] + wz1 * field[row + 1] + wz2 * field[row + 2])
+            row = stencil_row(st, a, b, ny, nz)
+            total += st.wx[a] * st.wy[b] * (st.wz[0] * field[row] + st.wz[1] * field[row + 1]
+                                            + st.wz[2] * field[row + 2])
     return total
 
 
@@ -488,19 +466,20 @@ def _det_i_plus(dt, L):
 
 
 @njit(cache=True)
-def freeze_particles(p_from, p_to, v, C, v_grid, stress, J, vol0, mass, mat_a, mat_b, frac_a, table):
+def freeze_particles(P, v_grid, table, p_from, p_to):
     """Freeze the particles p_from <= p < p_to as the active zone leaves them behind.
 
-    Reads their v, stress, J, vol0, mass, materials and the packed table; zeroes their v, C and
-    v_grid (a frozen particle is at rest and keeps its position and stress). Returns (elastic energy they keep,
-    kinetic energy they lose), in J. Serial: a few particles per step.
+    Reads their P.v, stress, J, vol0, mass, materials and the packed ``table``; zeroes their P.v, P.C and
+    v_grid (a frozen particle is at rest and keeps its position and stress). Returns (elastic energy they
+    keep, kinetic energy they lose), in J. Serial: a few particles per step.
     """
+    v, C, stress = P.v, P.C, P.stress
     elastic = 0.0
     kinetic = 0.0
     for p in range(p_from, p_to):
-        K, G = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
-        elastic += elastic_energy_density(stress, p, K, G) * vol0[p] * J[p]
-        kinetic += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
+        K, G = mixed_moduli(table[P.mat_a[p]], table[P.mat_b[p]], P.frac_a[p])
+        elastic += elastic_energy_density(stress, p, K, G) * P.vol0[p] * P.J[p]
+        kinetic += 0.5 * P.mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
         for d in range(3):
             v[p, d] = 0.0
             v_grid[p, d] = 0.0
