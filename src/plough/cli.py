@@ -161,8 +161,8 @@ def _note_interface(scene: Scene) -> None:
     if scene.interface_sticks:
         print(f"plough: note: the interface (tau = {scene.sticking_ratio:.3g} kappa) is at or above the wave limit "
               f"cos^2 alpha = {scene.wave_limit_ratio:.3g} of a perfectly plastic surface: no steady state "
-              "expected, and mu measured to follow the simulated speed and mass scaling without settling (README, "
-              "Interface shear)", file=sys.stderr)
+              "expected, and mu measured to follow the simulated speed and mass scaling without settling "
+              "(docs/model.md, 3.8 The interface regime and the wave limit)", file=sys.stderr)
 
 
 def build_parser() -> argparse.ArgumentParser:

@@ -12,7 +12,7 @@ Equations (the paper's numbers):
 
 Everything is numpy and broadcasts over its inputs; SI units throughout.
 
-Decisions where model.md leaves room (also in the README):
+Decisions where model.md leaves room (also in docs/model.md, section 2):
 
 - Friction is divided by the *applied* load Fn, also when the geometry is computed for the
   corrected load Fn' (the corrected load is the reaction the contact carries, the applied load is

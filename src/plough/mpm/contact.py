@@ -190,7 +190,7 @@ def sphere_contact(G, S, law, step, dt, out):
     excluded here: behind the sphere it moves away from the material (no push), and ahead the zone's end
     lies at least 2 expected contact radii and 20 h from the centre (over the workflow's runs the
     sphere's surface there is at least 5.6 um above the expected groove depth, about one contact reach
-    at h = 2.5 um; README, "Active zone").
+    at h = 2.5 um; docs/journal/2026-11-23-active-zone.md).
     """
     grid_m, grid_v, cbuf, flags, last_push = G.m, G.v, G.cbuf, G.flags, G.last_push
     origin, dx, shape, centre, radius, v_sphere = G.origin, G.dx, G.shape, S.centre, S.radius, S.velocity

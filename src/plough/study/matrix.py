@@ -45,7 +45,7 @@ ANALYTICAL_OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp")
 SWEEP_FIGURES = ("fig11", "fig13", "fig15", "fig16", "fig18", "fig20", "fig21", "fig23")
 SINGLE_RUN_FIGURES = ("fig12", "fig14", "fig17", "fig19")
 MPM_FIGURES = tuple(sorted(SWEEP_FIGURES + SINGLE_RUN_FIGURES))
-#: ``mpm.finest_failure``: what a finest sweep run that stops unstable leaves (README, "Rebuild one figure")
+#: ``mpm.finest_failure``: what a finest sweep run that stops unstable leaves (docs/workflow.md)
 FINEST_FAILURE_CHOICES = ("record", "stop")
 FINEST_FAILURE_DEFAULT = "record"
 #: ``mpm.ladder``: the particle sizes of each MPM point (``point_ladder``; docs/workflow.md, "The ladder")
