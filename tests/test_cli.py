@@ -167,3 +167,28 @@ def test_mpm_unwritable_output_is_refused_before_the_run(case, message, monkeypa
     assert main(argv) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and message in err and "Traceback" not in err
+
+
+@pytest.mark.parametrize("steady, expected", [(1, "window steady"), (0, "window NOT steady (mu drift -5.4%)")])
+def test_mpm_prints_the_result_summary(steady, expected, tmp_path):
+    """After a run, ``plough mpm`` prints mu and dp with their standard errors, the load held and steadiness."""
+    import json
+
+    import xarray as xr
+
+    from plough.cli import summarise_result
+
+    values = {"mu": 0.342, "mu_pl": 0.2267, "mu_sh": 0.1153, "dp": 6.1e-6, "dg": 4.48e-6, "hpu": 1.61e-6,
+              "Fz_mean": 3.08, "steady": steady, "mu_drift": -0.054, "mu_standard_error": 0.013,
+              "dp_standard_error": 1.6e-6}
+    ds = xr.Dataset({k: ((), v) for k, v in values.items()})
+    ds.attrs.update(scene=json.dumps({"name": "quick", "load_N": 3.0}), cost_particles=3200, cost_steps=3411,
+                    cost_wall_time_s=17.2, resolution="contact radius 3.3 particle sizes: resolved")
+    path = tmp_path / "r.nc"
+    ds.to_netcdf(path)
+    text = summarise_result(path)
+    assert "quick: wrote" in text
+    assert "mu  0.342 +- 0.013" in text and "mu_pl 0.227" in text and "mu_sh 0.115" in text
+    assert "dp  6.1 +- 1.6 um" in text and "dg 4.48 um" in text and "hpu 1.61 um" in text
+    assert "mean Fz / load 1.027" in text and expected in text and "resolved" in text
+    assert "3,200 particles, 3,411 steps, 17 s" in text

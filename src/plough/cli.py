@@ -7,10 +7,12 @@ line and exit code 130, and leaves no partial file (results and snapshots are wr
 from __future__ import annotations
 
 import argparse
+import json
 import re
 import sys
 import warnings
 from collections.abc import Callable, Sequence
+from pathlib import Path
 from typing import TYPE_CHECKING, Any, TextIO
 
 from plough import __version__
@@ -142,9 +144,36 @@ def _run_mpm(args: argparse.Namespace) -> int:
         from plough.mpm.run import run_scene_file
     except ImportError as exc:  # pragma: no cover - until the solver lands
         raise ValueError(f"the MPM solver is not available in this build: {exc}") from None
-    run_scene_file(args.scene, args.output, snapshots_dir=args.snapshots, threads=args.threads,
-                   progress=not args.quiet, preset=args.preset, on_scene=_note_interface, on_defaults=_note_defaults)
+    path = run_scene_file(args.scene, args.output, snapshots_dir=args.snapshots, threads=args.threads,
+                          progress=not args.quiet, preset=args.preset, on_scene=_note_interface,
+                          on_defaults=_note_defaults)
+    print(summarise_result(path))
     return 0
+
+
+def summarise_result(path: str | Path) -> str:
+    """The few numbers a user reads first from a result file: the steady-state friction and its parts, the
+    groove, how well the load was held, whether the window was steady, and what the run cost."""
+    import xarray as xr
+
+    with xr.open_dataset(path) as ds:
+        def value(name: str, scale: float = 1.0, fmt: str = ".3f") -> str:
+            text = f"{float(ds[name]) * scale:{fmt}}"
+            se = f"{name}_standard_error"
+            return text + (f" +- {float(ds[se]) * scale:.2g}" if se in ds else "")
+
+        scene = json.loads(ds.attrs["scene"])
+        steady = "steady" if int(ds["steady"]) else f"NOT steady (mu drift {float(ds['mu_drift']):+.1%})"
+        return "\n".join([
+            f"{scene.get('name', Path(path).stem)}: wrote {path}",
+            f"  mu  {value('mu')}   (ploughing mu_pl {value('mu_pl')}, interface shear mu_sh {value('mu_sh')})",
+            f"  dp  {value('dp', 1e6, '.3g')} um   (groove dg {float(ds['dg']) * 1e6:.3g} um, "
+            f"pile-up hpu {float(ds['hpu']) * 1e6:.3g} um)",
+            f"  mean Fz / load {float(ds['Fz_mean']) / scene['load_N']:.3f}; window {steady}"
+            + (f"; {ds.attrs['resolution']}" if "resolution" in ds.attrs else ""),
+            f"  {int(ds.attrs['cost_particles']):,} particles, {int(ds.attrs['cost_steps']):,} steps, "
+            f"{float(ds.attrs['cost_wall_time_s']):.0f} s",
+        ])
 
 
 def _note_defaults(defaults: dict[str, Any]) -> None:
