@@ -9,7 +9,7 @@ Whether the window is a steady state is checked, not assumed: ``mu_drift`` (mu o
 second half against its first) and ``material_top_rise`` (how far the highest particle rose
 between the halves: a growing prow) give ``steady``. ``<name>_standard_error`` (mu, mu_pl, mu_sh,
 dp) are the sampling errors of those means: a delete-one-batch jackknife over contiguous batches
-of the window's records and of the residual sections (README "Lattice phase: the noise of one run").
+of the window's records and of the residual sections (docs/model.md, 5 The noise of one run).
 
 Snapshots are VTK XML PolyData (.vtp) files, which ParaView and OVITO open.
 """
@@ -255,7 +255,7 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
     The steady window is a finite sample of a fluctuating force and the residual groove a finite
     number of sections: these errors estimate how far the same run with a different but equally
     long sample (the sphere started elsewhere against the particle lattice) would move mu and dp;
-    measured against such runs they are order-of-magnitude bars (README "Lattice phase"). dp's
+    measured against such runs they are order-of-magnitude bars (docs/journal/2026-11-23-lattice-phase.md). dp's
     error is omitted when fewer than 2 sections were measured.
     """
     idx = np.flatnonzero(mask)
@@ -439,7 +439,7 @@ def interface_regime(scene: Scene) -> str:
         return (f"tau = {sticking:.3g} kappa of a perfectly plastic surface the sphere touches, at or above the wave "
                 f"limit cos^2 alpha = {limit:.3g} of the expected contact: no steady state expected (the contact "
                 "can stick and a prow of the layer build up ahead of the sphere); mu measured to follow the "
-                "simulated speed and mass scaling without settling (README, Interface shear)")
+                "simulated speed and mass scaling without settling (docs/model.md, 3.8)")
     if ratio >= limit:
         capped = "capped at kappa" if ratio >= 1.0 else f"= {ratio:.3g} kappa, at or above the wave limit {limit:.3g},"
         return f"tau {capped} of a strain-hardening surface (not flagged; speed dependence not measured)"

@@ -308,17 +308,17 @@ class Discretisation:
     projected on the grid (an F-bar-like treatment of volumetric locking, see
     :mod:`plough.mpm.transfers`); "local" uses each particle's own. Plastic flow is isochoric, and
     with "local" the block locks: on the coated reference scene at h = 20 / 10 um dp was 1.36 /
-    3.69 um against 4.07 / 12.99 um projected (README, "Volumetric locking").
+    3.69 um against 4.07 / 12.99 um projected (docs/journal/2026-11-22-projected-dilatation.md).
 
     ``graded``: particles of size h only in the *fine zone* along the track (|y| and depth within
     ``fine_zone_contact_radii`` (>= 1) expected contact radii and at least 6 h, over the block's whole
     length); outside it
     each complete 2 x 2 x 2 group of lattice particles is one particle of size 2 h (one per cell
-    at two particles per cell). The grid stays uniform. Off by default (README, "Graded particles").
+    at two particles per cell). The grid stays uniform. Off by default (docs/journal/2026-11-22-graded-particles.md).
     ``fine_zone_shape``: the zone's cross-section, "square" (default: |y| and the depth each
     within the half-width) or "disc" (the distance from the track's centre line on the surface
     within it: the corners, about 2 contact radii from the track in both y and depth, are coarse;
-    12-16% fewer particles on the reference scenes; README, "Graded particles").
+    12-16% fewer particles on the reference scenes; docs/journal/2026-11-23-disc-fine-zone.md).
 
     ``active_zone_contact_radii``: when set, only the particles that started within this many
     expected contact radii (and at least 20 h) behind or ahead of the sphere's centre (along the
@@ -327,7 +327,7 @@ class Discretisation:
     hold zero velocity, so the active material is clamped there as at the block's curved surface).
     The zone moves with the sphere and a particle that leaves it behind stays frozen; until
     particles lie frozen beyond an end of the zone, the block's own end face there stays free.
-    None (default) updates every particle (README, "Active zone").
+    None (default) updates every particle (docs/journal/2026-11-23-active-zone.md).
     """
 
     particle_size_m: float = 10e-6
@@ -942,7 +942,7 @@ def sized_domain(layers: Layers, load_N: float, sphere_radius_m: float, slide_m:
     ``end_margin_contact_radii * a`` before the start and after the end, both rounded up to whole
     particle sizes. The plastic zone of a sliding sphere reaches about 2 a;
     ``benchmarks/mpm_reference.py --sized-domain`` against the same without the flag compares it
-    with the paper's block (README).
+    with the paper's block (docs/journal/2026-11-22-paper-settings-cost.md).
     """
     if radius_contact_radii < 2.0 or end_margin_contact_radii < 2.0:
         raise ValueError(f"domain sizing factors radius_contact_radii = {radius_contact_radii!r}, "

@@ -51,9 +51,9 @@ from plough.mpm.scene import Scene
 
 # Load controller (see control_sphere): force filter, loop time constant and integral time in
 # steps, gain from the elastic contact stiffness 2 E* a times STIFFNESS_FACTOR. Measured on the
-# reference scene at h = 10 um (README): the vertical speed varies by 3.5% of the pressing speed
-# (it swung by +-75% with a gain tuned to the plastic stiffness Fn / dp), contact on 92% of the
-# steps, mean Fz within 0.3% of the load.
+# reference scene at h = 10 um (docs/model.md, 3.9 Load control): the vertical speed varies by 3.5%
+# of the pressing speed (it swung by +-75% with a gain tuned to the plastic stiffness Fn / dp),
+# contact on 92% of the steps, mean Fz within 0.3% of the load.
 FILTER_STEPS = 10.0
 CONTROL_STEPS = 40.0
 STIFFNESS_FACTOR = 1.0
