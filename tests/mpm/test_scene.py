@@ -463,7 +463,8 @@ def test_interface_default_and_expected_contact():
 
 def test_wave_limit_is_cos_squared_of_the_leading_edge_angle_of_the_expected_contact():
     """sin alpha = a / r of the analytical contact: 46.1 um on the uncoated reference scene (0.947), 65.1 um
-    on the coated one (0.894, between the f = 0.8 that settles and the f = 0.9 that does not, README)."""
+    on the coated one (0.894, between the f = 0.8 that settles and the f = 0.9 that does not;
+    docs/journal/2026-11-24-inertia-ladder-and-wave-limit.md)."""
     for name, expected in (("uncoated_rigid_plastic", 0.947), ("coated_rigid_plastic", 0.894)):
         s = Scene.from_dict(example_dict(name))
         a, _ = s.expected_contact()
@@ -558,7 +559,7 @@ def test_interface_ratio_counts_the_substrate_once_the_sphere_ploughs_through():
 
 
 def test_inertia_number_of_the_reference_scene():
-    """ms rho v^2 / H: 1e6 x 7850 kg/m^3 x (0.1 m/s)^2 / 900 MPa (the README's 0.087)."""
+    """ms rho v^2 / H: 1e6 x 7850 kg/m^3 x (0.1 m/s)^2 / 900 MPa (0.087, docs/model.md 3.3)."""
     s = Scene.from_dict(example_dict())
     assert s.inertia_number == pytest.approx(1e6 * s.layers.substrate.density_kg_m3 * 0.01 / 900e6, rel=1e-12)
     assert 0.08 < s.inertia_number < 0.09

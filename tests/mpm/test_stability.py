@@ -4,8 +4,8 @@ The small scene of ``benchmarks/stability_matrix.py`` (``examples/stability_smal
 1 N, h = 10 um, sized block).
 A completed run must give finite, physically bounded results: mu between 0.05 and 1.5, the mean
 normal force within 20% of the load, no particle centre inside the sphere, and (where the
-README documents that it holds) the energy terms within 15% of the sphere's work. The bounds are
-sanity bounds, not accuracy claims; the measured values are in the README's stability table.
+docs/verification.md documents that it holds) the energy terms within 15% of the sphere's work. The bounds are
+sanity bounds, not accuracy claims; the measured values are in docs/verification.md.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Physics verification of the MPM solver: Hertz, energy balance, mirror symmetry, inertia (issue 3).
 
-Slow runs (a few seconds to ~20 s each); the numbers they check are reported in the README.
+Slow runs (a few seconds to ~20 s each); the numbers they check are reported in docs/verification.md.
 """
 
 from __future__ import annotations
@@ -49,7 +49,7 @@ def indentation_force(h_um: float, depth_um: float, domain_um: float = 240.0, po
 def test_hertz_indentation_error_shrinks_with_h():
     """F = 4/3 E* sqrt(R) d^1.5 for a rigid sphere on an elastic half-space (depth d = 2 um).
 
-    Measured (README): +89% at h = 10 um, +34% at h = 5 um with the projected dilatation (before
+    Measured (docs/verification.md): +89% at h = 10 um, +34% at h = 5 um with the projected dilatation (before
     it: +102% / +33% / +20% at h = 10 / 5 / 2.5 um) with a block of 12 contact radii; the contact
     acts on grid nodes up to one cell outside the sphere, an error of order h that halving h more
     than halves.
@@ -64,7 +64,7 @@ def test_hertz_indentation_error_shrinks_with_h():
 def test_projected_dilatation_removes_volumetric_locking_in_hertz_contact():
     """Hertz holds for any Poisson ratio; a locking discretisation gets stiffer as nu -> 0.5.
 
-    Measured at h = 10 um, depth 2 um (README, "Volumetric locking"): the error against Hertz is
+    Measured at h = 10 um, depth 2 um (docs/journal/2026-11-22-projected-dilatation.md): the error against Hertz is
     +104% at nu = 0.3 and +155% at nu = 0.499 with each particle's own dilatation, +89% and +91%
     with the projected one (the rest of the error is the contact resolution, see the test above).
     """
@@ -122,7 +122,7 @@ def test_energy_balance(half_and_full):
     Tolerance 10%: the terms are accumulated independently (grid impulses for the work and the
     two contact losses, particle stress power for the plastic and elastic parts), and the
     APIC transfers dissipate a little kinetic energy that no term counts; the measured sum
-    exceeds the work by 7% on the reference scene at h = 10 um (README: an open item).
+    exceeds the work by 7% on the reference scene at h = 10 um (docs/verification.md: an open item).
     """
     for ds in half_and_full:
         work = float(ds.external_work[-1])
