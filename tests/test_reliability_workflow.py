@@ -32,6 +32,7 @@ import yaml
 
 from plough.io import to_json
 from plough.study import matrix
+from tests.test_workflow_mpm import _job_counts as job_stats
 
 ROOT = Path(__file__).resolve().parents[1]
 SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
@@ -74,18 +75,10 @@ def _snakemake(work: Path, *args: str, own_src: bool = True, timeout: int = 600)
 
 def _job_counts(text: str) -> dict[str, int]:
     """The 'Job stats' table of a Snakemake (dry) run: rule -> number of jobs (empty: nothing to do)."""
-    lines = text.splitlines()
-    if "Job stats:" not in lines:
+    if "Job stats:" not in text.splitlines():
         assert "Nothing to be done" in text, text[-3000:]
         return {}
-    start = lines.index("Job stats:")
-    counts = {}
-    for line in lines[start + 3:]:
-        if not line.strip():
-            break
-        name, count = line.split()
-        counts[name] = int(count)
-    return counts
+    return job_stats(text)
 
 
 def _planned(work: Path, *args: str) -> tuple[dict[str, int], str]:
