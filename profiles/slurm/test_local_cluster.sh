@@ -37,13 +37,22 @@ started=()
 log() { echo "[$(date +%H:%M:%S)] $*"; }
 
 cleanup() {
+    # the test cluster's own jobs first (slurmd waits for their steps), then the daemons this script started
+    if [[ " ${started[*]} " == *slurmctld.pid* ]]; then
+        scancel --quiet --user root 2>/dev/null || true
+        sleep 2
+    fi
     for pidfile in "${started[@]}"; do
-        if [[ -s $pidfile ]]; then
-            kill "$(cat "$pidfile")" 2>/dev/null || true
-        fi
+        [[ -s $pidfile ]] || continue
+        pid=$(cat "$pidfile")
+        kill "$pid" 2>/dev/null || continue
+        for _ in $(seq 20); do kill -0 "$pid" 2>/dev/null || break; sleep 0.5; done
+        kill -9 "$pid" 2>/dev/null || true
     done
 }
 trap cleanup EXIT
+trap 'exit 143' TERM
+trap 'exit 130' INT
 
 log "installing slurm-wlm and munge (apt-get)"
 apt-get update -qq
