@@ -192,3 +192,14 @@ def test_mpm_prints_the_result_summary(steady, expected, tmp_path):
     assert "dp  6.1 +- 1.6 um" in text and "dg 4.48 um" in text and "hpu 1.61 um" in text
     assert "mean Fz / load 1.027" in text and expected in text and "resolved" in text
     assert "3,200 particles, 3,411 steps, 17 s" in text
+
+
+def test_mpm_summary_leaves_out_what_the_file_does_not_hold(tmp_path):
+    import xarray as xr
+
+    from plough.cli import summarise_result
+
+    path = tmp_path / "r.nc"
+    xr.Dataset({"mu": ((), 0.5)}).to_netcdf(path)
+    text = summarise_result(path)
+    assert "mu  0.500" in text and "dp  - um" in text and "steady" not in text

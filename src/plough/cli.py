@@ -153,27 +153,37 @@ def _run_mpm(args: argparse.Namespace) -> int:
 
 def summarise_result(path: str | Path) -> str:
     """The few numbers a user reads first from a result file: the steady-state friction and its parts, the
-    groove, how well the load was held, whether the window was steady, and what the run cost."""
+    groove, how well the load was held, whether the window was steady, and what the run cost. A quantity
+    the file does not hold is left out of the summary."""
     import xarray as xr
 
     with xr.open_dataset(path) as ds:
         def value(name: str, scale: float = 1.0, fmt: str = ".3f") -> str:
+            if name not in ds:
+                return "-"
             text = f"{float(ds[name]) * scale:{fmt}}"
             se = f"{name}_standard_error"
             return text + (f" +- {float(ds[se]) * scale:.2g}" if se in ds else "")
 
-        scene = json.loads(ds.attrs["scene"])
-        steady = "steady" if int(ds["steady"]) else f"NOT steady (mu drift {float(ds['mu_drift']):+.1%})"
-        return "\n".join([
-            f"{scene.get('name', Path(path).stem)}: wrote {path}",
-            f"  mu  {value('mu')}   (ploughing mu_pl {value('mu_pl')}, interface shear mu_sh {value('mu_sh')})",
-            f"  dp  {value('dp', 1e6, '.3g')} um   (groove dg {float(ds['dg']) * 1e6:.3g} um, "
-            f"pile-up hpu {float(ds['hpu']) * 1e6:.3g} um)",
-            f"  mean Fz / load {float(ds['Fz_mean']) / scene['load_N']:.3f}; window {steady}"
-            + (f"; {ds.attrs['resolution']}" if "resolution" in ds.attrs else ""),
-            f"  {int(ds.attrs['cost_particles']):,} particles, {int(ds.attrs['cost_steps']):,} steps, "
-            f"{float(ds.attrs['cost_wall_time_s']):.0f} s",
-        ])
+        scene = json.loads(ds.attrs.get("scene", "{}"))
+        lines = [f"{scene.get('name', Path(path).stem)}: wrote {path}",
+                 f"  mu  {value('mu')}   (ploughing mu_pl {value('mu_pl')}, interface shear mu_sh {value('mu_sh')})",
+                 f"  dp  {value('dp', 1e6, '.3g')} um   (groove dg {value('dg', 1e6, '.3g')} um, "
+                 f"pile-up hpu {value('hpu', 1e6, '.3g')} um)"]
+        state = []
+        if "Fz_mean" in ds and "load_N" in scene:
+            state.append(f"mean Fz / load {float(ds['Fz_mean']) / scene['load_N']:.3f}")
+        if "steady" in ds:
+            drift = f" (mu drift {float(ds['mu_drift']):+.1%})" if "mu_drift" in ds else ""
+            state.append("window steady" if int(ds["steady"]) else f"window NOT steady{drift}")
+        if "resolution" in ds.attrs:
+            state.append(str(ds.attrs["resolution"]))
+        if state:
+            lines.append("  " + "; ".join(state))
+        if {"cost_particles", "cost_steps", "cost_wall_time_s"} <= set(ds.attrs):
+            lines.append(f"  {int(ds.attrs['cost_particles']):,} particles, {int(ds.attrs['cost_steps']):,} steps, "
+                         f"{float(ds.attrs['cost_wall_time_s']):.0f} s")
+        return "\n".join(lines)
 
 
 def _note_defaults(defaults: dict[str, Any]) -> None:
