@@ -21,7 +21,7 @@ import xarray as xr
 import yaml
 
 from plough import cli
-from plough.mpm import contact, io, solver, transfers
+from plough.mpm import contact, growth, io, solver, transfers
 from plough.mpm import run as run_module
 from plough.mpm import scene as scene_module
 from plough.mpm.grid import FIXED, FREE, boundary_flags
@@ -245,6 +245,13 @@ def test_check_stability_names_step_sliding_distance_and_cause(tiny_state, code)
     solver.check_stability(state, const)
 
 
+def end_of_step(state, const):
+    """What a step does after its kernels: the grid grows for the particles past a growing face, then the
+    checks stop the run on what is left."""
+    growth.grow_to_hold(state, const)
+    solver.check_stability(state, const)
+
+
 def _flag_outside(state, const, index, axis, over_m):
     """Mark particle ``index`` as having left the grid ``over_m`` past its high face along ``axis``, as the
     G2P kernel reports it."""
@@ -265,11 +272,11 @@ def test_a_particle_above_a_hand_set_grid_top_is_named_a_prow_and_points_at_the_
     assert const.grid_top_limit_m == 0.0  # the scene's own headroom is kept
     _flag_above_the_top(state, const)
     with pytest.raises(solver.InstabilityError, match=r"rose above the grid's top.*domain\.headroom_m") as err:
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert "stops at" not in str(err.value) and not state.grid_raises
     state.particles.x[5, 2] = 0.0  # left through a side: the general cause
     with pytest.raises(solver.SimulationError) as err:
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "headroom" not in str(err.value)
 
 
@@ -290,11 +297,11 @@ def test_a_particle_past_a_fixed_grids_far_end_is_named_material_pushed_ahead(ti
     end = tiny_scene.domain.length_m * 1e6
     where = rf"past the grid's far end .*the block ends at {end:.1f} um\), {ahead:.1f} um ahead of the sphere's centre"
     with pytest.raises(solver.InstabilityError, match=where + r".*domain\.length_m") as err:
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert "lengthens" not in str(err.value) and not state.grid_extensions
     state.particles.x[7, 0] = const.grid_lo[0] - 0.2 * const.grid.dx
     with pytest.raises(solver.InstabilityError) as err:
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value) and "far end" not in str(err.value)
 
 
@@ -309,7 +316,7 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
     assert end0 > tiny_scene.domain.length_m  # the grid starts a few cells past the block
     _flag_past_the_end(state, const)
     far = float(state.particles.x[7, 0])
-    solver.check_stability(state, const)  # no error
+    end_of_step(state, const)  # no error
     assert const.grid.shape[1:] == (ny, nz) and const.grid.shape[0] > nx
     assert far + dx + 0.25 * r <= const.grid_hi[0] < far + 2.0 * dx + 0.25 * r
     assert list(const.shape) == list(const.grid.shape) and np.array_equal(const.grid.origin, solver.init(
@@ -323,12 +330,12 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
     _flag_past_the_end(state, const, over_m=2.0 * r)
     limit = rf"lengthens past the block's end by 2 sphere radii at most, to x = {const.grid_end_limit_m * 1e6:.1f}"
     with pytest.raises(solver.InstabilityError, match=r"past the grid's far end.*" + limit):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert len(state.grid_extensions) == 1
     # past the limit by less than the quarter radius wanted: the grid ends at the limit
     state2, const2 = solver.init(tiny_scene, n_chunks=1)
     _flag_past_the_end(state2, const2, over_m=2.0 * r - 3.0 * dx)
-    solver.check_stability(state2, const2)
+    end_of_step(state2, const2)
     assert const2.grid_end_limit_m - dx < const2.grid_hi[0] <= const2.grid_end_limit_m + 1e-12
     # a particle past the far end and above the top on one step, or one past the end (the flagged one) and
     # another above the top: both grow
@@ -336,14 +343,14 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
         state3, const3 = solver.init(tiny_scene, n_chunks=1)
         _flag_past_the_end(state3, const3)
         state3.particles.x[other, 2] = const3.grid_hi[2] + 0.1 * dx
-        solver.check_stability(state3, const3)
+        end_of_step(state3, const3)
         assert len(state3.grid_extensions) == len(state3.grid_raises) == 1, other
-        assert solver._outside_index(state3) == -1
+        assert growth._outside_index(state3) == -1
     state4, const4 = solver.init(tiny_scene, n_chunks=1)
     _flag_past_the_end(state4, const4)
     state4.particles.x[7, 0] = const4.grid_lo[0] - 0.2 * dx
     with pytest.raises(solver.InstabilityError):
-        solver.check_stability(state4, const4)
+        end_of_step(state4, const4)
     assert not state4.grid_extensions
 
 
@@ -369,7 +376,7 @@ def _growth_peak_bytes(state, shape, extra, axis):
     """The memory a growth by ``extra`` layers along ``axis`` should count, written out: the run's arrays, plus
     the added layers of every per-node array or the new per-chunk P2G buffers beside the old, whichever is more."""
     w = state.work
-    held = solver._array_bytes(state.particles) + solver._array_bytes(w)
+    held = growth._array_bytes(state.particles) + growth._array_bytes(w)
     per_layer = sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push,
                                        w.flags)) // shape[axis]
     return held + max(per_layer * extra, w.grid_buf.nbytes // shape[axis] * (shape[axis] + extra))
@@ -380,14 +387,14 @@ def test_a_lengthening_that_would_not_fit_in_memory_stops_the_run_naming_the_mem
     shape = const.grid.shape
     for extra in (1, 4, shape[0]):
         peak = _growth_peak_bytes(state, shape, extra, axis=0)
-        assert solver.raise_bytes(state, shape, extra, axis=0) == peak
+        assert growth.raise_bytes(state, shape, extra, axis=0) == peak
         with pytest.raises(solver.InstabilityError, match=rf"passed the grid's far end, and lengthening it by {extra} "
                                                           "node layers would hold"):
-            solver.check_raise_memory(state, shape, extra, peak - 1, axis=0)
+            growth.check_raise_memory(state, shape, extra, peak - 1, axis=0)
     _flag_past_the_end(state, const)  # a fifth of a cell past the end: needs 2 layers, wants a quarter radius more
-    need = solver.raise_bytes(state, shape, 2, axis=0)
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need)
-    solver.check_stability(state, const)
+    need = growth.raise_bytes(state, shape, 2, axis=0)
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: need)
+    end_of_step(state, const)
     assert const.grid.shape[0] == shape[0] + 2 and len(state.grid_extensions) == 1
 
 
@@ -399,38 +406,38 @@ def test_a_raise_and_a_lengthening_on_one_step_share_the_memory(tiny_scene, monk
     shape = const.grid.shape
     _flag_past_the_end(state, const)  # needs 2 x layers
     state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * const.grid.dx  # needs 2 z layers; doubling wants more
-    assert solver._layers_past(state, const, 0, const.grid_end_limit_m) == 2
+    assert growth._layers_past(state, const, 0) == 2
     wanted = math.ceil(const.grid_hi[2] / const.grid.dx - 1e-9)
     assert wanted > 2
-    both_needed = solver.growth_bytes(state, shape, [(2, 2), (0, 2)])
-    assert solver.raise_bytes(state, shape, wanted) <= both_needed  # the doubled room alone would fit
-    assert solver.growth_bytes(state, shape, [(2, wanted), (0, 2)]) > both_needed  # but not with the lengthening
+    both_needed = growth.growth_bytes(state, shape, [(2, 2), (0, 2)])
+    assert growth.raise_bytes(state, shape, wanted) <= both_needed  # the doubled room alone would fit
+    assert growth.growth_bytes(state, shape, [(2, wanted), (0, 2)]) > both_needed  # but not with the lengthening
     # a byte less: the run stops before either grows, naming both
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: both_needed - 1)
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: both_needed - 1)
     with pytest.raises(solver.InstabilityError, match=r"raising it by 2 node layers and then lengthening it by 2 "
                                                       "would hold"):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert const.grid.shape == shape and not state.grid_raises and not state.grid_extensions
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: both_needed)
-    solver.check_stability(state, const)
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: both_needed)
+    end_of_step(state, const)
     assert const.grid.shape == (shape[0] + 2, shape[1], shape[2] + 2)
-    assert len(state.grid_raises) == len(state.grid_extensions) == 1 and solver._outside_index(state) == -1
+    assert len(state.grid_raises) == len(state.grid_extensions) == 1 and growth._outside_index(state) == -1
     # the same whichever of the two particles the kernel flagged
     state1, const1 = solver.init(tiny_scene, n_chunks=2)
     _flag_above_the_top(state1, const1)
     state1.particles.x[7, 0] = const1.grid_hi[0] + 0.2 * const1.grid.dx
-    solver.check_stability(state1, const1)
+    end_of_step(state1, const1)
     assert const1.grid.shape == (shape[0] + 2, shape[1], shape[2] + 2)
     # with memory for the doubled top and the needed lengthening the top doubles (the lengthening then takes
     # what room it wants within what is left)
     state2, const2 = solver.init(tiny_scene, n_chunks=2)
     _flag_past_the_end(state2, const2)
     state2.particles.x[5, 2] = const2.grid_hi[2] + 0.1 * const2.grid.dx
-    monkeypatch.setattr(solver, "physical_memory_bytes",
-                        lambda: solver.growth_bytes(state2, shape, [(2, wanted), (0, 2)]))
-    solver.check_stability(state2, const2)
+    monkeypatch.setattr(growth, "physical_memory_bytes",
+                        lambda: growth.growth_bytes(state2, shape, [(2, wanted), (0, 2)]))
+    end_of_step(state2, const2)
     assert const2.grid.shape[2] == shape[2] + wanted and const2.grid.shape[0] >= shape[0] + 2
-    assert len(state2.grid_raises) == len(state2.grid_extensions) == 1 and solver._outside_index(state2) == -1
+    assert len(state2.grid_raises) == len(state2.grid_extensions) == 1 and growth._outside_index(state2) == -1
 
 
 def test_growth_bytes_counts_growths_in_turn_as_the_grid_really_grows(tiny_scene):
@@ -438,25 +445,25 @@ def test_growth_bytes_counts_growths_in_turn_as_the_grid_really_grows(tiny_scene
     arrays the first really left; each growth adds exactly its layers of every per-node array."""
     state, const = solver.init(tiny_scene, n_chunks=2)
     shape = const.grid.shape
-    assert solver.growth_bytes(state, shape, [(0, 4)]) == solver.raise_bytes(state, shape, 4, axis=0)
-    predicted = solver.growth_bytes(state, shape, [(2, 3), (0, 4)])
-    first_peak = solver.raise_bytes(state, shape, 3, axis=2)
+    assert growth.growth_bytes(state, shape, [(0, 4)]) == growth.raise_bytes(state, shape, 4, axis=0)
+    predicted = growth.growth_bytes(state, shape, [(2, 3), (0, 4)])
+    first_peak = growth.raise_bytes(state, shape, 3, axis=2)
 
     def held():
-        return solver._array_bytes(state.particles) + solver._array_bytes(state.work)
+        return growth._array_bytes(state.particles) + growth._array_bytes(state.work)
 
     def node_bytes():
         w = state.work
         return sum(a.nbytes for a in (w.grid_buf, w.grid_m, w.grid_v, w.grid_div, w.cbuf, w.last_push, w.flags))
 
     held0, node0 = held(), node_bytes()
-    solver.grow_grid(state, const, 2, 3)
+    growth.grow_grid(state, const, 2, 3)
     assert held() - held0 == node0 * 3 // shape[2]
-    second_peak = solver.raise_bytes(state, const.grid.shape, 4, axis=0)
-    assert predicted == max(first_peak, second_peak) > solver.raise_bytes(
+    second_peak = growth.raise_bytes(state, const.grid.shape, 4, axis=0)
+    assert predicted == max(first_peak, second_peak) > growth.raise_bytes(
         solver.init(tiny_scene, n_chunks=2)[0], shape, 4, axis=0)  # more than the lengthening on the old grid
     held1, node1 = held(), node_bytes()
-    solver.grow_grid(state, const, 0, 4)
+    growth.grow_grid(state, const, 0, 4)
     assert held() - held1 == node1 * 4 // shape[0]
 
 
@@ -476,7 +483,7 @@ def _grown_at_start_and_both_run_on(scene, late, c_late, axis, extra):
     both it and ``late`` (grown mid-run) step on to 150 steps past ``late``'s step. Returns the one grown at
     the start."""
     start, c_start = solver.init(scene, n_chunks=1)
-    solver.grow_grid(start, c_start, axis, extra)
+    growth.grow_grid(start, c_start, axis, extra)
     assert c_start.grid.shape == c_late.grid.shape
     assert np.array_equal(start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
     for _ in range(late.step + 150 - start.step):
@@ -495,7 +502,7 @@ def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_lon
     late, c_late = solver.init(scene, n_chunks=1)
     while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6 and late.zone.p_hi == late.particles.n):
         solver.step(late, c_late)  # until the zone reached the block's end: it must follow the new end
-    solver.grow_grid(late, c_late, 0, 6)
+    growth.grow_grid(late, c_late, 0, 6)
     start, c_start = _grown_at_start_and_both_run_on(scene, late, c_late, 0, 6)
     assert late.zone.n_hi == start.zone.n_hi == c_late.grid.n_nodes
     assert late.zone.check_hi_m[0] == start.zone.check_hi_m[0] == c_late.grid_hi[0]
@@ -517,7 +524,7 @@ def test_a_particle_past_a_fixed_grids_side_is_named_material_thrown_sideways(ti
     side = tiny_scene.domain.radius_m * 1e6
     with pytest.raises(solver.InstabilityError, match=rf"out through the grid's side .*the block's side is at "
                                                       rf"{side:.1f} um\).*domain\.radius_m") as err:
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert "widens" not in str(err.value) and not state.grid_widenings
 
 
@@ -533,7 +540,7 @@ def test_a_particle_past_the_side_widens_the_automatic_grid_up_to_its_limit(tiny
     old_flags = state.work.flags.copy()
     _flag_past_the_side(state, const)
     far = float(state.particles.x[7, 1])
-    solver.check_stability(state, const)  # no error
+    end_of_step(state, const)  # no error
     assert const.grid.shape[0] == nx and const.grid.shape[2] == nz and const.grid.shape[1] > ny
     assert far + dx + 0.25 * r <= const.grid_hi[1] < far + 2.0 * dx + 0.25 * r
     assert list(const.shape) == list(const.grid.shape)
@@ -549,13 +556,13 @@ def test_a_particle_past_the_side_widens_the_automatic_grid_up_to_its_limit(tiny
     _flag_past_the_side(state, const, over_m=2.0 * r)
     limit = rf"widens past the block's side by 2 sphere radii at most, to y = {const.grid_side_limit_m * 1e6:.1f}"
     with pytest.raises(solver.InstabilityError, match=r"out through the grid's side.*" + limit):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert len(state.grid_widenings) == 1
     state2, const2 = solver.init(tiny_scene, n_chunks=1)
     _flag_past_the_side(state2, const2)
     state2.particles.x[9, 2] = const2.grid_lo[2] - dx
     with pytest.raises(solver.InstabilityError, match="particle 9 "):
-        solver.check_stability(state2, const2)
+        end_of_step(state2, const2)
     assert not state2.grid_widenings and const2.grid.shape == (nx, ny, nz)
 
 
@@ -567,7 +574,7 @@ def test_a_widening_past_its_limit_stops_the_run_before_another_growth_on_that_s
     _flag_above_the_top(state, const)
     state.particles.x[9, 1] = const.grid_side_limit_m + const.grid.dx
     with pytest.raises(solver.InstabilityError) as err:
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert "out through the grid's side" in str(err.value) and "widens past the block's side" in str(err.value)
     assert "particle 9 " in str(err.value)
     assert const.grid.shape == shape and not (state.grid_raises or state.grid_widenings)
@@ -580,13 +587,13 @@ def test_a_full_block_widens_at_its_high_side_with_its_own_flags(tiny_scene):
     state, const = solver.init(scene, n_chunks=1)
     shape = const.grid.shape
     _flag_past_the_side(state, const)
-    solver.check_stability(state, const)
+    end_of_step(state, const)
     assert const.grid.shape[1] > shape[1] and len(state.grid_widenings) == 1
     assert np.array_equal(state.work.flags, boundary_flags(const.grid, scene.domain.radius_m, False))
     state.particles.x[7, 1] = const.grid_lo[1] - 0.2 * const.grid.dx
     state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
     with pytest.raises(solver.InstabilityError, match="particle 7 "):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert len(state.grid_widenings) == 1
 
 
@@ -599,17 +606,17 @@ def test_three_growths_on_one_step_all_grow_and_share_the_memory(tiny_scene, mon
     _flag_past_the_side(state, const)  # needs 2 y layers
     state.particles.x[5, 2] = const.grid_hi[2] + 0.1 * dx  # 2 z layers
     state.particles.x[9, 0] = const.grid_hi[0] + 0.2 * dx  # 2 x layers
-    needed = solver.growth_bytes(state, shape, [(2, 2), (0, 2), (1, 2)])
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: needed - 1)
+    needed = growth.growth_bytes(state, shape, [(2, 2), (0, 2), (1, 2)])
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: needed - 1)
     with pytest.raises(solver.InstabilityError, match=r"raising it by 2 node layers and then lengthening it by 2 "
                                                       r"and then widening it by 2 would hold"):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert const.grid.shape == shape and not (state.grid_raises or state.grid_extensions or state.grid_widenings)
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: needed)
-    solver.check_stability(state, const)
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: needed)
+    end_of_step(state, const)
     assert const.grid.shape == (shape[0] + 2, shape[1] + 2, shape[2] + 2)
     assert len(state.grid_raises) == len(state.grid_extensions) == len(state.grid_widenings) == 1
-    assert solver._outside_index(state) == -1
+    assert growth._outside_index(state) == -1
     assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
 
 
@@ -622,7 +629,7 @@ def test_a_run_whose_grid_was_widened_goes_on_as_if_it_had_started_on_the_wider_
     while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6):
         solver.step(late, c_late)
     old_slab, slabs = c_late.grid.shape[1] * c_late.grid.shape[2], (late.zone.n_lo, late.zone.n_hi)
-    solver.grow_grid(late, c_late, 1, 5)
+    growth.grow_grid(late, c_late, 1, 5)
     new_slab = c_late.grid.shape[1] * c_late.grid.shape[2]
     assert (late.zone.n_lo, late.zone.n_hi) == (slabs[0] // old_slab * new_slab, slabs[1] // old_slab * new_slab)
     start, c_start = _grown_at_start_and_both_run_on(scene, late, c_late, 1, 5)
@@ -637,7 +644,7 @@ def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     state, const = solver.init(tiny_scene, n_chunks=1)
     old_shape, old_top, old_flags = const.grid.shape, float(const.grid_hi[2]), state.work.flags.copy()
     _flag_above_the_top(state, const)
-    solver.check_stability(state, const)  # no error
+    end_of_step(state, const)  # no error
     nx, ny, nz = const.grid.shape
     assert (nx, ny) == old_shape[:2] and nz > old_shape[2]
     assert 2.0 * old_top <= const.grid_hi[2] < 2.0 * old_top + const.grid.dx
@@ -655,7 +662,7 @@ def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     _flag_above_the_top(state2, const2)
     state2.particles.x[9, 2] = const2.grid_lo[2] - const2.grid.dx
     with pytest.raises(solver.InstabilityError, match="particle 9 ") as err:
-        solver.check_stability(state2, const2)
+        end_of_step(state2, const2)
     assert solver.CAUSES[transfers.BAD_LEFT_GRID] in str(err.value)
     assert not state2.grid_raises and const2.grid.shape == old_shape  # nothing grown for a run that stops
 
@@ -665,7 +672,7 @@ def test_the_automatic_grid_top_stops_at_the_spheres_top(tiny_scene):
     assert const.grid_top_limit_m == pytest.approx(2.0 * tiny_scene.sphere.radius_m)
     _flag_above_the_top(state, const, over_m=2.0 * tiny_scene.sphere.radius_m)
     with pytest.raises(solver.InstabilityError, match=r"rose above the grid's top.*stops at 2 sphere radii, 400\.0 um"):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert not state.grid_raises
 
 
@@ -673,14 +680,14 @@ def test_a_raise_that_doubling_would_carry_past_the_limit_stops_at_the_limit(tin
     """Room for the particle below the limit: the top goes to the limit (not refused because 2x passes it)."""
     state, const = solver.init(tiny_scene, n_chunks=1)
     dx, top0 = const.grid.dx, float(const.grid_hi[2])
-    const.grid_top_limit_m = 1.5 * top0
+    const = replace(const, grid_top_limit_m=1.5 * top0)  # the constants are frozen: a copy
     _flag_above_the_top(state, const)
-    solver.check_stability(state, const)
+    end_of_step(state, const)
     assert const.grid_top_limit_m - dx < const.grid_hi[2] <= const.grid_top_limit_m + 1e-12
     assert state.particles.x[5, 2] < const.grid_hi[2]
     _flag_above_the_top(state, const)  # no room left: the run stops, naming the limit
     with pytest.raises(solver.InstabilityError, match="automatic headroom stops at"):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert len(state.grid_raises) == 1
 
 
@@ -692,21 +699,21 @@ def test_a_raise_that_would_not_fit_in_memory_stops_the_run_naming_the_memory(ti
     shape = const.grid.shape
     for extra in (1, 3, shape[2]):
         peak = _growth_peak_bytes(state, shape, extra, axis=2)
-        assert solver.raise_bytes(state, shape, extra) == peak
-        solver.check_raise_memory(state, shape, extra, peak)
+        assert growth.raise_bytes(state, shape, extra) == peak
+        growth.check_raise_memory(state, shape, extra, peak)
         with pytest.raises(solver.InstabilityError, match=rf"raising it by {extra} node layers would hold"):
-            solver.check_raise_memory(state, shape, extra, peak - 1)
+            growth.check_raise_memory(state, shape, extra, peak - 1)
     # through check_stability: the particle, a tenth of a cell over the top, needs 2 layers (one cell of room
     # above it); doubling wants more
     _flag_above_the_top(state, const)
     assert 2 < shape[2]
-    need = solver.raise_bytes(state, shape, 2)
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need - 1)
+    need = growth.raise_bytes(state, shape, 2)
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: need - 1)
     with pytest.raises(solver.InstabilityError, match=r"raising it by 2 node layers would hold .* GiB, more than"):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
     assert const.grid.shape == shape and not state.grid_raises and state.work.grid_m.size == np.prod(shape)
-    monkeypatch.setattr(solver, "physical_memory_bytes", lambda: need)
-    solver.check_stability(state, const)
+    monkeypatch.setattr(growth, "physical_memory_bytes", lambda: need)
+    end_of_step(state, const)
     assert const.grid.shape[2] == shape[2] + 2 and len(state.grid_raises) == 1
     assert state.particles.x[5, 2] < const.grid_hi[2]
 
@@ -719,9 +726,9 @@ def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_tal
     raised_late, c_late = solver.init(scene, n_chunks=1)
     while not (raised_late.sphere.phase == "slide" and raised_late.sphere.slid_m >= 10e-6):
         solver.step(raised_late, c_late)
-    assert solver.raise_grid_top(raised_late, c_late)
+    assert growth.grow_face(raised_late, c_late, 2)
     from_start, c_start = solver.init(scene, n_chunks=1)
-    assert solver.raise_grid_top(from_start, c_start)
+    assert growth.grow_face(from_start, c_start, 2)
     assert np.array_equal(from_start.work.flags, boundary_flags(c_start.grid, scene.domain.radius_m, True))
     assert c_start.grid.shape == c_late.grid.shape
     for _ in range(raised_late.step + 150 - from_start.step):
@@ -740,17 +747,17 @@ def test_a_raised_grid_top_is_recorded_and_told(tiny_scene, tiny_run, monkeypatc
     assert tiny_run.attrs["cost_grid_nodes"] == tiny_run.attrs["cost_grid_nodes_end"] == const.grid.n_nodes
     real_step = solver.step
 
-    def step_raising_once(s, c):  # as check_stability would on a particle past the top, the end, then the side
+    def step_raising_once(s, c):  # as growth.grow_to_hold would on a particle past the top, the end, then the side
         real_step(s, c)
         if s.step == 40:
-            assert solver.raise_grid_top(s, c)
+            assert growth.grow_face(s, c, 2)
         if s.step == 50:
             s.particles.x[3, 0] = c.grid_hi[0] + 0.1 * c.grid.dx
-            assert solver.lengthen_grid(s, c)
+            assert growth.grow_face(s, c, 0)
             s.particles.x[3, 0] -= 0.1 * c.grid.dx
         if s.step == 60:
             s.particles.x[3, 1] = c.grid_hi[1] + 0.1 * c.grid.dx
-            assert solver.widen_grid(s, c)
+            assert growth.grow_face(s, c, 1)
             s.particles.x[3, 1] -= 0.1 * c.grid.dx
 
     monkeypatch.setattr(solver, "step", step_raising_once)
@@ -792,7 +799,7 @@ def test_check_stability_flags_runaway_kinetic_energy(tiny_state):
     state.work.acc[:] = 0.0
     state.work.acc[0, transfers.ACC_KINETIC] = 10.0 * (2e-9 + const.load_N * const.grid.dx)
     with pytest.raises(solver.InstabilityError, match=r"step 10 .*sliding distance 0\.0 um.*kinetic energy"):
-        solver.check_stability(state, const)
+        end_of_step(state, const)
 
 
 def test_non_finite_particle_during_sliding_stops_the_run(tiny_state):

@@ -135,7 +135,7 @@ def _y_edges(scene: Scene) -> np.ndarray:
 
 def within_block_width(y: np.ndarray, scene: Scene) -> np.ndarray:
     """Samples within the block's width, |y| <= R + h / 2: material thrown out past the side face (the grid
-    widens for it, ``solver.widen_grid``) is not the groove's surface, whereas a column near the face still is
+    widens for it, ``plough.mpm.growth``) is not the groove's surface, whereas a column near the face still is
     (it goes to the last y bin, as before)."""
     return np.abs(y) <= scene.domain.radius_m + 0.5 * scene.discretisation.particle_size_m
 

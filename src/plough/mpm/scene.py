@@ -208,9 +208,9 @@ class Domain:
     ``headroom_m`` is the height of the grid above the original surface, the room material has to
     rise into (pile-up, and the prow an adhesive interface pushes up the sphere's front); None
     sizes it from the expected groove (``Scene.grid_headroom_m``) and lets the solver raise it
-    mid-run where material reaches it (``solver.raise_grid_top``), and lengthen it past the block's
-    far end where material flung ahead passes it (``solver.lengthen_grid``), and widen it past the side
-    face where material thrown sideways passes it (``solver.widen_grid``); a value set here fixes the whole
+    mid-run where material reaches it, and lengthen it past the block's far end where material flung
+    ahead passes it, and widen it past the side face where material thrown sideways passes it
+    (:mod:`plough.mpm.growth`); a value set here fixes the whole
     grid, the top, the far end and the side. It costs grid nodes, not particles.
     """
 
@@ -574,8 +574,8 @@ class Scene:
         coating the sphere sweeps ahead) outgrows any fixed rule, and one expected contact radius more would
         cost 9-22% more grid nodes at h <= 5 um on the reference scenes: with this automatic value
         the solver raises the grid's top mid-run where material reaches it
-        (``solver.raise_grid_top``), lengthens the grid past the block's far end
-        (``solver.lengthen_grid``) and widens it past the side face (``solver.widen_grid``)."""
+        and lengthens the grid past the block's far end and widens it past the side face
+        (:mod:`plough.mpm.growth`)."""
         if self.domain.headroom_m is not None:
             return self.domain.headroom_m
         _, dp = self.expected_contact()

@@ -21,17 +21,18 @@ started within that many expected contact radii of the sphere's centre along x, 
 slabs around them (:class:`ActiveZone`): particles and nodes are stored x-major, so both are
 index ranges; the material beyond is frozen and clamps the active part.
 
-Material that rises past the grid's top (a prow that keeps growing) raises it mid-run where the
-scene leaves the headroom automatic (:func:`raise_grid_top`), and material flung past the block's far
-end (fragments of a soft coating's chip) lengthens it (:func:`lengthen_grid`), and material thrown out
-through the side face y = R widens it there (:func:`widen_grid`); any other particle leaving the grid, and
-a hand-set headroom, stop the run (:func:`check_stability`).
+Material that rises past the grid's top (a prow that keeps growing), is flung past the block's far end
+(fragments of a soft coating's chip) or thrown out through the side face y = R makes the grid grow there
+mid-run where the scene leaves the headroom automatic (:mod:`plough.mpm.growth`); any other particle
+leaving the grid, and a hand-set headroom, stop the run (:func:`check_stability`).
+
+The run's constants (:class:`Constants`) are frozen but for the grid, whose growth replaces it
+(:class:`GrowingGrid`); the state (:class:`State`) is everything else that changes.
 """
 
 from __future__ import annotations
 
 import math
-import os
 from dataclasses import dataclass, field
 
 import numba
@@ -42,10 +43,12 @@ from plough.materials import (
     ConstantShear,
     ProportionalShear,
 )
-from plough.mpm import contact, transfers
+from plough.mpm import contact, growth, transfers
 from plough.mpm.bundles import ContactLaw, GridData, MaterialData, SphereData, Zone
 from plough.mpm.constitutive import I_G, I_K, I_RHO, pack_materials
-from plough.mpm.grid import Grid, boundary_flags, extend_node_array, grown, make_grid, mirror_plane_index
+from plough.mpm.errors import InstabilityError, SimulationError  # noqa: F401 (callers catch solver.SimulationError)
+from plough.mpm.grid import Grid, boundary_flags, make_grid, mirror_plane_index
+from plough.mpm.growth import GRID_END_LIMIT_RADII, GRID_SIDE_LIMIT_RADII, GRID_TOP_LIMIT_RADII, physical_memory_bytes
 from plough.mpm.particles import Particles, seed_particles, uniform_particle_count
 from plough.mpm.scene import Scene
 
@@ -65,34 +68,6 @@ INTEGRAL_STEPS = 100.0
 #: particle moved about a cell past its start at the zone's end (material the sphere pushes far
 #: ahead) stops the run
 ZONE_PAD_CELLS = 4
-#: the automatic headroom is raised mid-run up to this many sphere radii above the original surface
-#: (the sphere's top): a soft coating the sphere sweeps ahead can stack far above the expected
-#: pile-up (H~ = 0.1 at h = 10 um: 197 um after 600 um of sliding, docs/journal/2026-11-23-preview-run.md), but
-#: material above the sphere is flung, not ploughed
-GRID_TOP_LIMIT_RADII = 2.0
-#: with the automatic headroom the grid also lengthens past the block's far end, up to this many sphere
-#: radii: a soft coating's chip sheds fragments the 1e6 mass scaling flings ahead of the sphere (H~ = 0.25 at
-#: h = 5 um: up to 377 um ahead, at 4.5x the slide speed, docs/journal/2026-11-23-soft-coating-fragments.md);
-#: they stay in the run
-GRID_END_LIMIT_RADII = 2.0
-#: each lengthening (and widening) adds room for the farthest particle plus this many sphere radii, so that
-#: fragments flying on do not reallocate the grid every few steps
-GRID_END_STEP_RADII = 0.25
-#: with the automatic headroom the grid also widens past the block's side face y = R (the high side; with
-#: the mirror plane the only one), up to this many sphere radii: the f = 0.5 coated run at h = 2.5 um threw a
-#: coating particle out through it, 13 um above the surface, 567.5 um into a 600 um slide
-#: (docs/journal/2026-11-24-coated-f0.5-h2.5-growing-grid.md)
-GRID_SIDE_LIMIT_RADII = 2.0
-
-
-class SimulationError(RuntimeError):
-    """A run could not finish: the message names the step, the sliding distance and the likely cause."""
-
-
-class InstabilityError(SimulationError):
-    """The state went unstable while running (non-finite values, J out of range, a particle leaving the
-    grid, kinetic energy out of proportion), as opposed to a run that cannot reach its load or loses
-    contact: the workflow may record it for a finest-size run (``mpm.finest_failure``)."""
 
 
 @dataclass
@@ -107,21 +82,35 @@ class SphereState:
 
 
 @dataclass
+class GrowingGrid:
+    """The one part of the run's constants that changes: the grid, which grows mid-run (:mod:`plough.mpm.growth`)."""
+
+    grid: Grid
+    shape: np.ndarray = field(init=False)  # (3,) int64: the grid's shape as the kernels take it
+    hi: np.ndarray = field(init=False)  # (3,) m: the high corner of the grid's interior (a cell in from the last nodes)
+
+    def __post_init__(self) -> None:
+        self.set(self.grid)
+
+    def set(self, grid: Grid) -> None:
+        """Take ``grid`` (the grown one) and what follows from it."""
+        self.grid, self.shape, self.hi = grid, np.array(grid.shape, dtype=np.int64), grid.upper - 1.0 * grid.dx
+
+
+@dataclass(frozen=True)
 class Constants:
-    """Everything a step needs that does not change during a run, but for the grid (``grid``, ``shape``,
-    ``grid_hi``) when its top is raised (:func:`raise_grid_top`), it is lengthened (:func:`lengthen_grid`) or
-    widened (:func:`widen_grid`)."""
+    """Everything a step needs that does not change during a run: frozen, but for the grid (``growing``:
+    ``grid``, ``shape`` and ``grid_hi`` read it), which :mod:`plough.mpm.growth` replaces when it grows."""
 
     dt: float
-    grid: Grid
+    growing: GrowingGrid
     table: np.ndarray
     rate_scale: float
     taylor_quinney: float
     interface_model: int
     interface_params: np.ndarray
     near_dist: float
-    grid_lo: np.ndarray
-    grid_hi: np.ndarray
+    grid_lo: np.ndarray  # (3,) m: the low corner of the grid's interior (it never grows that way)
     load_N: float
     symmetry_factor: float  # 2 with the mirror plane: the simulated half carries load_N / 2
     press_speed: float
@@ -136,19 +125,30 @@ class Constants:
     target_depth: float | None
     sphere_radius: float
     steps_slide: int
-    shape: np.ndarray = field(default_factory=lambda: np.zeros(3, dtype=np.int64))
     mirror_j0: int = -1  # index of the node plane y = 0 with symmetry, -1 without
     zone_half_width_m: float = 0.0  # m, active zone behind and ahead of the sphere centre; 0: every particle
     zone_x0_m: np.ndarray = field(default_factory=lambda: np.zeros(0))  # initial x of the particles, ascending
-    #: m, the highest the grid's top may be raised to when material reaches it (``raise_grid_top``); 0: never
+    #: m, the highest the grid's top may be raised to when material reaches it (:mod:`plough.mpm.growth`); 0: never
     #: (a headroom the scene sets by hand is kept)
     grid_top_limit_m: float = 0.0
-    #: m, the farthest the grid's far end may move to when material passes it (``lengthen_grid``); 0: never
+    #: m, the farthest the grid's far end may move to when material passes it (:mod:`plough.mpm.growth`); 0: never
     grid_end_limit_m: float = 0.0
-    #: m, the farthest the grid's side (high y) may move to when material passes it (``widen_grid``); 0: never
+    #: m, the farthest the grid's side (high y) may move to when material passes it (:mod:`plough.mpm.growth`); 0: never
     grid_side_limit_m: float = 0.0
     block_end_m: float = 0.0  # m, x of the block's far end face (the grid starts a few cells past it)
     block_side_m: float = 0.0  # m, y of the block's side face, its radius R (the grid starts a few cells past it)
+
+    @property
+    def grid(self) -> Grid:
+        return self.growing.grid
+
+    @property
+    def shape(self) -> np.ndarray:
+        return self.growing.shape
+
+    @property
+    def grid_hi(self) -> np.ndarray:
+        return self.growing.hi
 
     @property
     def material(self) -> MaterialData:
@@ -219,11 +219,11 @@ class State:
     zone: ActiveZone
     step: int = 0
     time: float = 0.0
-    #: (step, sliding distance m, new grid top m) of each raise of the grid's top (``raise_grid_top``)
+    #: (step, sliding distance m, new grid top m) of each raise of the grid's top (:mod:`plough.mpm.growth`)
     grid_raises: list[tuple[int, float, float]] = field(default_factory=list)
-    #: (step, sliding distance m, new grid end m) of each lengthening past the far end (``lengthen_grid``)
+    #: (step, sliding distance m, new grid end m) of each lengthening past the far end
     grid_extensions: list[tuple[int, float, float]] = field(default_factory=list)
-    #: (step, sliding distance m, new grid side m) of each widening past the side face (``widen_grid``)
+    #: (step, sliding distance m, new grid side m) of each widening past the side face
     grid_widenings: list[tuple[int, float, float]] = field(default_factory=list)
 
 
@@ -247,14 +247,6 @@ def interface_arrays(scene: Scene) -> tuple[int, np.ndarray]:
 #: bytes of one particle's state (position, velocity, affine matrix, stress and the scalars, float64)
 #: without the grid or any scratch: a lower bound, so that only a run that cannot fit is refused
 STATE_BYTES_PER_PARTICLE = 250
-
-
-def physical_memory_bytes() -> int | None:
-    """This machine's physical memory, or None where the OS does not say."""
-    try:
-        return int(os.sysconf("SC_PAGE_SIZE")) * int(os.sysconf("SC_PHYS_PAGES"))
-    except (AttributeError, ValueError, OSError):
-        return None
 
 
 def check_memory(scene: Scene, available_bytes: int | None = None) -> None:
@@ -299,10 +291,13 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     n_chunks = n_chunks or max(numba.get_num_threads(), 1)
     centre = np.array([scene.start_x_m, 0.0, r])
     k_est = contact_stiffness(scene, a_exp)
+    zone_x0 = particles.x[:, 0].copy() if scene.active_zone_half_width_m is not None else np.zeros(0)
+    if np.any(np.diff(zone_x0) < 0.0):
+        raise AssertionError("particles are not seeded x-major: the active zone needs them sorted along x")
     const = Constants(
-        dt=dt, grid=grid, table=table, rate_scale=scene.rate_scale, taylor_quinney=scene.outputs.taylor_quinney,
-        interface_model=model, interface_params=iparams, near_dist=3.0 * dx,
-        grid_lo=grid.origin + 1.0 * dx, grid_hi=grid.upper - 1.0 * dx, load_N=scene.load_N,
+        dt=dt, growing=GrowingGrid(grid), table=table, rate_scale=scene.rate_scale,
+        taylor_quinney=scene.outputs.taylor_quinney, interface_model=model, interface_params=iparams,
+        near_dist=3.0 * dx, grid_lo=grid.origin + 1.0 * dx, load_N=scene.load_N,
         symmetry_factor=2.0 if scene.domain.symmetric else 1.0,
         press_speed=scene.sliding.press_speed_fraction * scene.sliding.speed_m_s,
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
@@ -311,13 +306,14 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         contact_hold_steps=contact.HOLD_WAVE_TIMES * dx / (c * dt),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
-        shape=np.array(grid.shape, dtype=np.int64), mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
+        mirror_j0=mirror_plane_index(grid, scene.domain.symmetric),
         grid_top_limit_m=GRID_TOP_LIMIT_RADII * r if scene.domain.headroom_m is None else 0.0,
         grid_end_limit_m=(scene.domain.length_m + GRID_END_LIMIT_RADII * r if scene.domain.headroom_m is None
                           else 0.0),
         grid_side_limit_m=(scene.domain.radius_m + GRID_SIDE_LIMIT_RADII * r if scene.domain.headroom_m is None
                            else 0.0),
         block_end_m=scene.domain.length_m, block_side_m=scene.domain.radius_m,
+        zone_half_width_m=scene.active_zone_half_width_m or 0.0, zone_x0_m=zone_x0,
     )
     work = Work(
         grid_buf=transfers.allocate_grid_buffers(n_chunks, grid.n_nodes), grid_m=np.zeros(grid.n_nodes),
@@ -328,11 +324,6 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
         L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
     )
-    if scene.active_zone_half_width_m is not None:
-        const.zone_half_width_m = scene.active_zone_half_width_m
-        const.zone_x0_m = particles.x[:, 0].copy()
-        if np.any(np.diff(const.zone_x0_m) < 0.0):
-            raise AssertionError("particles are not seeded x-major: the active zone needs them sorted along x")
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
     if const.zone_half_width_m > 0.0:  # empty ranges, opened by the first update
         zone = ActiveZone(p_lo=0, p_hi=0, n_lo=0, n_hi=0, i_free_lo=-1, i_free_hi=-1)
@@ -375,6 +366,7 @@ def step(s: State, c: Constants) -> None:
     transfers.g2p_update(P, G, c.material, S, Z, c.dt, c.project_dilatation, w.v_grid, w.L_buf, w.acc,
                          transfers.G2P_BLOCK)  # the stress update and advection
     account_energy(w)
+    growth.grow_to_hold(s, c)  # room for the particles past a growing face of the grid
     check_stability(s, c)
     control_sphere(s.sphere, c.symmetry_factor * reaction_z(w), c)
     s.step += 1
@@ -509,19 +501,15 @@ CAUSES = {
 
 
 def check_stability(s: State, c: Constants) -> None:
-    """Stop at once, naming the step, the sliding distance and the likely cause; a particle past an
-    automatic grid top raises the top (:func:`raise_grid_top`), one past the block's far end lengthens
-    the grid (:func:`lengthen_grid`), one past its side widens it (:func:`widen_grid`), where that holds
-    every particle and fits in memory."""
+    """Stop at once on the worst flag the step's kernels left (``g2p_update``'s accumulators), naming the
+    step, the sliding distance and the likely cause, and on kinetic energy out of proportion; it only
+    detects: a particle past a face of the grid that grows has been answered before
+    (:func:`plough.mpm.growth.grow_to_hold`: the flag is cleared, or names the particle still outside)."""
     acc = s.work.acc
     bad = int(acc[:, transfers.ACC_BAD].max())
     where = f"at step {s.step} (t = {s.time:.4g} s, sliding distance {s.sphere.slid_m * 1e6:.1f} um)"
     chunk = int(np.argmax(acc[:, transfers.ACC_BAD]))
     index = int(acc[chunk, transfers.ACC_BAD_INDEX])
-    if bad == transfers.BAD_LEFT_GRID and index >= 0:
-        index = _grow_to_hold(s, c, index)
-        if index < 0:
-            bad = transfers.BAD_NONE  # the grown grid holds every particle
     if bad != transfers.BAD_NONE:
         cause = CAUSES[bad]
         if bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]:
@@ -563,245 +551,6 @@ def _growth_limit_note(what: str, radii: float, axis_name: str, limit_m: float) 
     if limit_m <= 0.0:
         return ""
     return f"; the grid {what} by {radii:g} sphere radii at most, to {axis_name} = {limit_m * 1e6:.1f} um"
-
-
-def _grow_to_hold(s: State, c: Constants, index: int) -> int:
-    """Raise the grid's top, lengthen it past the far end and widen it past the side as far as the particles
-    outside need and the limits allow; the particle still outside afterwards (``index`` where nothing grew),
-    -1 if none.
-
-    All are sized on this step's particles before any grows: the raise first, its wanted room counted against
-    the memory together with the growths that follow (each of which then checks itself). Nothing grows where a
-    particle is outside for a reason no growth mends (:func:`_outside_for_good`): the run stops on it."""
-    stuck = _outside_for_good(s, c)
-    if stuck >= 0:
-        return stuck
-    z = s.zone
-    x = s.particles.x[z.p_lo:z.p_hi]
-    lengthen = _layers_past(s, c, 0, c.grid_end_limit_m)
-    widen = _layers_past(s, c, 1, c.grid_side_limit_m)
-    # a particle past a face that cannot grow as far stops the run before anything grows: it is the one named
-    for axis, layers in ((0, lengthen), (1, widen)):
-        far = int(np.argmax(x[:, axis]))
-        if x[far, axis] > c.grid_hi[axis] and not layers:
-            return z.p_lo + far
-    top = int(np.argmax(x[:, 2]))
-    if x[top, 2] > c.grid_hi[2]:
-        if not raise_grid_top(s, c, then=tuple((axis, n) for axis, n in ((0, lengthen), (1, widen)) if n)):
-            return z.p_lo + top
-    elif not (lengthen or widen):
-        return index  # nothing to grow: the particle the kernel flagged
-    if lengthen:
-        lengthen_grid(s, c, then=((1, widen),) if widen else ())
-    if widen:
-        widen_grid(s, c)
-    return _outside_index(s)
-
-
-def _outside_for_good(s: State, c: Constants) -> int:
-    """An active particle outside the positions check's box other than above the grid's top, past its far
-    end or past its side where the grid may widen (through the bottom, the low side, the near end, the side
-    of a grid that does not widen, or out of the active zone's slabs), -1 if none."""
-    z = s.zone
-    x = s.particles.x[z.p_lo:z.p_hi]
-    low = np.any(x < z.check_lo_m, axis=1)
-    side = x[:, 1] > z.check_hi_m[1] if c.grid_side_limit_m <= 0.0 else np.zeros(len(x), dtype=bool)
-    zone = (x[:, 0] > z.check_hi_m[0]) & (x[:, 0] <= c.grid_hi[0])
-    out = np.flatnonzero(low | side | zone)
-    return int(z.p_lo + out[0]) if out.size else -1
-
-
-def _layers_past(s: State, c: Constants, axis: int, limit_m: float) -> int:
-    """Node layers a growth along ``axis`` (0: past the far end, 1: past the side) needs for the active
-    particles beyond the grid's interior there (one cell past the farthest), 0 where none is beyond it, the
-    grid cannot grow that way (``limit_m`` 0) or the room needed would pass ``limit_m``."""
-    if limit_m <= 0.0:
-        return 0
-    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, axis].max())
-    now = float(c.grid_hi[axis])
-    if far <= now:
-        return 0
-    need = max(_layers_to(far + c.grid.dx, now, c.grid.dx), 1)
-    return need if need <= math.floor((limit_m - now) / c.grid.dx + 1e-9) else 0
-
-
-def _layers_to(target_m: float, now_m: float, dx: float) -> int:
-    """Whole node layers that carry the grid's interior from ``now_m`` to ``target_m`` at least."""
-    return math.ceil((target_m - now_m) / dx - 1e-9)
-
-
-def raise_grid_top(s: State, c: Constants, then: tuple[tuple[int, int], ...] = ()) -> bool:
-    """Raise the grid's top mid-run so that every active particle has room again; False where the
-    scene set its headroom by hand or the room would pass ``Constants.grid_top_limit_m``; stops the run
-    (:func:`check_raise_memory`) where even the room the particles need would not fit in memory.
-
-    The room above the surface at least doubles (a few raises cover any prow; only the room needed
-    where the doubled one, followed by the growths ``then`` ((axis, node layers), ...) the same step
-    makes next, would not fit in memory), one cell above the highest particle at least, and stops at the
-    limit. The new layers' flags are those of the old top layer (above the surface
-    they depend on y alone); see :func:`grow_grid`.
-    """
-    if c.grid_top_limit_m <= 0.0:
-        return False
-    top = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 2].max())
-    # room for the highest particle, wanted: the room doubled
-    if not _grow_within(s, c, 2, top + c.grid.dx, max(2.0 * float(c.grid_hi[2]), top + c.grid.dx),
-                        c.grid_top_limit_m, then):
-        return False
-    s.grid_raises.append((s.step, s.sphere.slid_m, float(c.grid_hi[2])))
-    return True
-
-
-def lengthen_grid(s: State, c: Constants, then: tuple[tuple[int, int], ...] = ()) -> bool:
-    """Lengthen the grid past the block's far end mid-run so that every active particle has room again
-    (fragments of a soft coating's chip flung ahead of the sphere); False where the scene set its headroom
-    by hand (a fixed grid) or the room would pass ``Constants.grid_end_limit_m``; stops the run
-    (:func:`check_raise_memory`) where it would not fit in memory.
-
-    The room reaches one cell past the farthest particle plus ``GRID_END_STEP_RADII`` sphere radii, and stops
-    at the limit. Past the block's end the nodes' flags depend on y and z alone (the curved surface, the
-    mirror plane), so the new x layers copy the old last one; see :func:`grow_grid`. ``then``: the growths
-    the same step makes next, counted against the memory (:func:`raise_grid_top`).
-    """
-    if c.grid_end_limit_m <= 0.0:
-        return False
-    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 0].max())
-    if not _grow_within(s, c, 0, far + c.grid.dx, far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius,
-                        c.grid_end_limit_m, then):
-        return False
-    s.grid_extensions.append((s.step, s.sphere.slid_m, float(c.grid_hi[0])))
-    return True
-
-
-def widen_grid(s: State, c: Constants) -> bool:
-    """Widen the grid past the block's side face y = R mid-run so that every active particle has room again
-    (material a soft coating's prow throws sideways); False where the scene set its headroom by hand (a fixed
-    grid) or the room would pass ``Constants.grid_side_limit_m``; stops the run (:func:`check_raise_memory`)
-    where it would not fit in memory.
-
-    The room reaches one cell past the farthest particle plus ``GRID_END_STEP_RADII`` sphere radii, and stops
-    at the limit. Past the side face the nodes' flags depend on z alone (fixed below the surface, the curved
-    face's outside; free above), so the new y layers copy the old last one; see :func:`grow_grid`. Only the
-    high side grows: with the mirror plane it is the only side; a full block's low side (y = -R) does not.
-    """
-    if c.grid_side_limit_m <= 0.0:
-        return False
-    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, 1].max())
-    if not _grow_within(s, c, 1, far + c.grid.dx, far + c.grid.dx + GRID_END_STEP_RADII * c.sphere_radius,
-                        c.grid_side_limit_m):
-        return False
-    s.grid_widenings.append((s.step, s.sphere.slid_m, float(c.grid_hi[1])))
-    return True
-
-
-def _grow_within(s: State, c: Constants, axis: int, need_m: float, want_m: float, limit_m: float,
-                 then: tuple[tuple[int, int], ...] = ()) -> bool:
-    """Grow the grid's interior along ``axis`` to ``want_m``, or less, down to ``need_m``, where the limit
-    (``limit_m``) or the memory says so; False, nothing grown, where even ``need_m`` passes the limit. The
-    memory counts the growths ``then`` ((axis, node layers), ...) that follow on the same step: the wanted room
-    only where all fit, and where even the needed room and ``then`` do not, the run stops before any grows."""
-    now, dx = float(c.grid_hi[axis]), c.grid.dx
-    need, wanted = _layers_to(need_m, now, dx), _layers_to(want_m, now, dx)
-    allowed = math.floor((limit_m - now) / dx + 1e-9)
-    extra = min(wanted, allowed)
-    if extra < max(need, 1):
-        return False
-    available = physical_memory_bytes()
-    if available is not None and growth_bytes(s, c.grid.shape, [(axis, extra), *then]) > available:
-        extra = max(need, 1)  # the wanted room does not fit in memory: the room the particles need
-    check_raise_memory(s, c.grid.shape, extra, available, axis, then)
-    grow_grid(s, c, axis, extra)
-    return True
-
-
-def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
-    """Add ``extra`` node layers at the high end of ``axis`` (2: the top, 0: past the far end, 1: past the side).
-
-    The origin stays put, so every node keeps its (i, j, k) and position: the per-node arrays are copied
-    into the grown layout (new layers empty, contact memory unpushed, flags copied from the old last layer)
-    and the run goes on as if it had started on the grown grid. The active zone's node range, free slabs
-    and positions check follow the new far end where they reached the old one. A particle outside the old
-    grid on this step moved with a complete stencil on it (it was inside before the move).
-    """
-    g, z, w = c.grid, s.zone, s.work
-    shape, new = g.shape, grown(g, extra, axis)
-    w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0, grid_axis=axis)
-    w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0, grid_axis=axis)
-    w.grid_v = extend_node_array(w.grid_v, shape, extra, fill=0.0, grid_axis=axis)
-    w.grid_div = extend_node_array(w.grid_div, shape, extra, fill=0.0, grid_axis=axis)
-    w.cbuf = extend_node_array(w.cbuf, shape, extra, fill=0.0, grid_axis=axis)
-    w.last_push = extend_node_array(w.last_push, shape, extra, fill=contact.NEVER_PUSHED, grid_axis=axis)
-    w.flags = extend_node_array(w.flags, shape, extra, grid_axis=axis)
-    old_slab, new_slab = shape[1] * shape[2], new.shape[1] * new.shape[2]
-    if axis in (1, 2):  # x-major: the zone's node range keeps its slabs, each slab taller or wider
-        z.n_lo, z.n_hi = z.n_lo // old_slab * new_slab, z.n_hi // old_slab * new_slab
-    else:  # the slabs keep their size; a zone that reached the old far end reaches the new one
-        z.n_hi = new.n_nodes if z.n_hi == g.n_nodes else z.n_hi
-        z.i_free_hi = new.shape[0] if z.i_free_hi == shape[0] else z.i_free_hi
-    old_hi = c.grid_hi.copy()
-    c.grid, c.shape = new, np.array(new.shape, dtype=np.int64)
-    c.grid_hi = new.upper - 1.0 * new.dx
-    if z.check_hi_m[axis] == old_hi[axis]:
-        z.check_hi_m[axis] = c.grid_hi[axis]
-
-
-def _array_bytes(obj: object) -> int:
-    """Bytes of the arrays a dataclass or a named tuple (the particles) holds."""
-    values = obj._asdict().values() if hasattr(obj, "_asdict") else vars(obj).values()
-    return sum(v.nbytes for v in values if isinstance(v, np.ndarray))
-
-
-def raise_bytes(s: State, shape: tuple[int, int, int], extra: int, axis: int = 2) -> int:
-    """Bytes the run holds at the peak of growing the grid by ``extra`` node layers along ``axis``: its
-    particle and per-node arrays, plus the layers added, or the new per-chunk P2G buffers while the old ones
-    are still held (most of a run's node memory), whichever is more."""
-    return growth_bytes(s, shape, [(axis, extra)])
-
-
-def growth_bytes(s: State, shape: tuple[int, int, int], growths: list[tuple[int, int]]) -> int:
-    """Bytes the run holds at the peak of growing the grid by each ``(axis, node layers)`` of ``growths`` in
-    turn (:func:`raise_bytes` for each, on the grid the ones before it left)."""
-    node = sum(a.nbytes for a in (s.work.grid_buf, s.work.grid_m, s.work.grid_v, s.work.grid_div, s.work.cbuf,
-                                  s.work.last_push, s.work.flags))
-    buffers = s.work.grid_buf.nbytes
-    held = _array_bytes(s.particles) + _array_bytes(s.work)
-    peak, dims = held, list(shape)
-    for axis, extra in growths:
-        added = node * extra // dims[axis]  # one layer is 1 / dims[axis] of the nodes
-        new_buffers = buffers * (dims[axis] + extra) // dims[axis]
-        peak = max(peak, held + max(added, new_buffers))
-        held, node, buffers = held + added, node + added, new_buffers
-        dims[axis] += extra
-    return peak
-
-
-def check_raise_memory(s: State, shape: tuple[int, int, int], extra: int, available: int | None,
-                       axis: int = 2, then: tuple[tuple[int, int], ...] = ()) -> None:
-    """Stop before growing the grid by ``extra`` node layers along ``axis``, and then by each of ``then``
-    ((axis, node layers), ...), if that would not fit in ``available`` bytes, this machine's physical memory
-    (:func:`growth_bytes`; ``check_memory`` counted the particles alone, before the grid could grow); None:
-    not known, no check. The whole machine's memory: jobs beside the run are not counted."""
-    if available is None:
-        return
-    peak = growth_bytes(s, shape, [(axis, extra), *then])
-    if peak > available:
-        what = {2: "rose above the grid's top, and raising it", 0: "passed the grid's far end, and lengthening it",
-                1: "passed the grid's side, and widening it"}[axis]
-        verb = {2: "raising", 0: "lengthening", 1: "widening"}
-        more = "".join(f" and then {verb[a]} it by {n}" for a, n in then)
-        raise InstabilityError(
-            f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material {what} "
-            f"by {extra} node layers{more} would hold {peak / 2**30:.3g} GiB, more than this machine's "
-            f"{available / 2**30:.3g} GiB of memory (a growing prow or chip: coarser particles, a smaller domain, "
-            "or a hand-set domain.headroom_m to stop there)")
-
-
-def _outside_index(s: State) -> int:
-    """An active particle outside the positions check's box, -1 if none."""
-    z = s.zone
-    x = s.particles.x[z.p_lo:z.p_hi]
-    out = np.flatnonzero(np.any((x < z.check_lo_m) | (x > z.check_hi_m), axis=1))
-    return int(z.p_lo + out[0]) if out.size else -1
 
 
 def _left_zone(s: State, c: Constants, x: float) -> bool:
