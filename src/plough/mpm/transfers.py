@@ -29,6 +29,11 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
   results followed the time step. The FLIP increment keeps that part; positions move with the
   grid velocity, so the particles do not drift apart.
 
+Interfaces: each kernel takes the named bundles of :mod:`plough.mpm.bundles` (``P`` the particles, ``G``
+the grid, ``M`` the materials, ``S`` the sphere, ``Z`` the zone's ranges) and says which of their fields it
+reads and writes; a particle's 27-node stencil is set up by :func:`plough.mpm.shape.stencil`, for these
+kernels and the contact's alike.
+
 Threads: P2G and the kinematics cut the particles into ``n_chunks`` contiguous chunks (in seeding
 order, so a chunk is a slab of the block); ``g2p_update``, whose cost per particle varies (a
 plastic particle's return map costs several flow-law evaluations, and they cluster around the
