@@ -139,6 +139,7 @@ def _coated_at(h_um: float, f: float, mass_scaling_factor: float = 1.0) -> Scene
     return replace(base, interface=ProportionalShear(f=f), discretisation=disc).with_sized_domain()
 
 
+@pytest.mark.long  # 12 min on the shared 2-core machine (three coated runs, one at a quarter of the mass scaling)
 def test_inertia_moves_mu_less_than_the_discretisation_where_a_steady_state_exists():
     """Issue 3's inertia check at a size CI affords, below the wave limit (f = 0, the ploughing alone): on the
     coated scene at h = 10 um, mass scaling / 4 (the same numbers as speed / 2) moves mu by a small fraction
