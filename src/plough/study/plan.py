@@ -365,8 +365,10 @@ def _refinement(plan: Plan) -> str:
     n_need, n_skip, n_open = states.count(True), states.count(False), states.count(None)
     every = list(plan.runs)
     high, low = plan.made(every, undecided=True), plan.made(every, undecided=False)
-    tol = plan.config["mpm"].get("skip_finest_tolerance")
-    return (f"refinement only where needed (skip_finest_tolerance {tol}): {len(states)} gated finest runs "
+    from plough.study.skipping import tolerances
+
+    tol = ", ".join(f"{o} {t:g}" for o, t in tolerances(plan.config["mpm"]["skip_finest_tolerance"]).items())
+    return (f"refinement only where needed (skip_finest_tolerance: {tol}): {len(states)} gated finest runs "
             f"({n_need} decided needed, {n_skip} decided not, {n_open} undecided): between "
             f"**{_hours(plan.wall_s(low))}** ({len(low)} runs, "
             f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps; every undecided one skipped) and "
