@@ -48,6 +48,26 @@ def refinement_needed(decision_file):
     return bool(json.loads(Path(decision_file).read_text())["run_finest"])
 
 
+def dataset_inputs(wc):
+    """The run files a figure's dataset reads and the refinement decisions it follows (checkpoint mpm_refine,
+    mpm.smk): a gated finest run (SKIPPABLE) only once its decision says it is needed. Until a decision is
+    made its file (the checkpoint's target) stands in, caught here rather than raised, so that every decision
+    of the figure is scheduled at once and the dataset is re-planned as each one lands."""
+    runs = runs_of(wc.figure)
+    decisions = []
+    for finest in [r for r in runs if r in SKIPPABLE]:
+        try:
+            path = checkpoints.mpm_refine.get(run=finest).output[0]
+        except IncompleteCheckpointException as undecided:
+            decisions.append(undecided.targetfile)
+            del runs[finest]
+            continue
+        decisions.append(path)
+        if not refinement_needed(path):
+            del runs[finest]
+    return {"runs": list(runs.values()), "decisions": decisions}
+
+
 def runs_of(figure):
     """run id -> result file of every run a figure's dataset needs."""
     return {rid: f"results/runs/{rid}.nc" for rid in matrix.figure_runs(config, figure)}

@@ -65,25 +65,6 @@ checkpoint mpm_refine:
         "../scripts/mpm_refine.py"
 
 
-def dataset_inputs(wc):
-    """The run files a figure's dataset reads and the refinement decisions it follows: a gated finest run
-    (SKIPPABLE) only once its decision says it is needed; until a decision is made, its file (the checkpoint's
-    target) stands in, so that every decision is scheduled at once and the dataset is re-planned as each lands."""
-    runs = runs_of(wc.figure)
-    decisions = []
-    for finest in [r for r in runs if r in SKIPPABLE]:
-        try:
-            path = checkpoints.mpm_refine.get(run=finest).output[0]
-        except IncompleteCheckpointException as undecided:
-            decisions.append(undecided.targetfile)
-            del runs[finest]
-            continue
-        decisions.append(path)
-        if not refinement_needed(path):
-            del runs[finest]
-    return {"runs": list(runs.values()), "decisions": decisions}
-
-
 # A figure's dataset reads its runs' files, its points' refinement decisions, and the part of the config
 # that places them (its points, sizes, which finest runs may be gated or failure markers:
 # plough.study.runfiles.figure_view), not the whole mpm section: a config change redoes exactly the
