@@ -279,8 +279,8 @@ def test_a_corrupt_run_file_is_a_one_line_error_naming_it(tmp_path, damage):
     assert str(bad) in msg and "unreadable" in msg and "snakemake" in msg
 
 
-def test_the_skip_decision_refuses_a_corrupt_coarser_run(tmp_path, monkeypatch):
-    """A finest run reads its two coarser runs to decide whether to skip: a broken one is named."""
+def test_the_refinement_decision_refuses_a_corrupt_coarser_run(tmp_path):
+    """A point's refinement decision (checkpoint mpm_refine) reads its two coarser runs: a broken one is named."""
     import copy
 
     cfg = copy.deepcopy(SMOKE)
@@ -295,18 +295,16 @@ def test_the_skip_decision_refuses_a_corrupt_coarser_run(tmp_path, monkeypatch):
     ds.attrs["solver_fingerprint"] = solver_fingerprint()
     ds.to_netcdf(coarse_p)  # a good coarse run
     mid_p.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 100)  # an HDF5 signature, then nothing
-    monkeypatch.setattr(sys, "stderr", sys.stderr)  # the script points it at its log; restored after
-    smk = _Namespace(params=_Namespace(scene=matrix.all_runs(cfg)[finest], skip_tolerance=0.5,
-                                       coarser_sizes_um=list(matrix.particle_sizes_um(cfg)[-3:-1]),
-                                       solver=solver_fingerprint()),
-                     input=_Namespace(coarser=[str(coarse_p), str(mid_p)]), output=[str(tmp_path / f"{finest}.nc")],
-                     log=[str(tmp_path / "run.log")], threads=1, config=cfg, wildcards=_Namespace(run=finest))
+    out = tmp_path / "refinement" / f"{finest}.json"
+    smk = _Namespace(params=_Namespace(tolerance=0.5, coarser=[coarse, mid], solver=solver_fingerprint()),
+                     input=_Namespace(coarser=[str(coarse_p), str(mid_p)]), output=[str(out)],
+                     log=[str(tmp_path / "refine.log")], config=cfg, wildcards=_Namespace(run=finest))
     with pytest.raises(SystemExit) as err:
-        runpy.run_path(str(ROOT / "workflow/scripts/mpm_run.py"), init_globals={"snakemake": smk})
+        runpy.run_path(str(ROOT / "workflow/scripts/mpm_refine.py"), init_globals={"snakemake": smk})
     msg = str(err.value.code)
     _one_line(msg)
     assert str(mid_p) in msg and "unreadable" in msg
-    assert not (tmp_path / f"{finest}.nc").exists()
+    assert not out.exists()
 
 
 def test_the_workflow_remakes_a_broken_run_file_the_way_the_error_says(tmp_path):

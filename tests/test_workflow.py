@@ -1,5 +1,6 @@
 """The Snakemake workflow driven from pytest in a temporary copy (smoke config)."""
 
+import math
 import shutil
 import subprocess
 import sys
@@ -58,3 +59,90 @@ def test_full_matrix_dry_run(workdir):
     text = out.stdout + out.stderr
     for fig in ("fig03", "fig04", "fig22"):
         assert fig in text
+    # refinement only where needed (config/config.yaml): the decisions are planned, the DAG changes after them
+    assert "checkpoint mpm_refine:" in text and "checkpoint jobs" in text
+
+
+def _job_counts(text: str) -> dict[str, int]:
+    """The 'Job stats' table of a Snakemake (dry) run: rule -> number of jobs ({} when nothing is to be done)."""
+    lines = text.splitlines()
+    if "Job stats:" not in lines:
+        return {}
+    counts = {}
+    for line in lines[lines.index("Job stats:") + 3:]:
+        if not line.strip():
+            break
+        name, count = line.split()
+        counts[name] = int(count)
+    return counts
+
+
+def test_refinement_checkpoint_decides_then_asks_only_for_the_needed_finest_runs(tmp_path):
+    """Refinement only where needed (checkpoint mpm_refine) on the smoke Fig. 15 with made-up run files (no MPM run):
+    before the decisions `-n` lists them and no gated finest run; each decision follows plough.study.skipping from
+    the coarser files; then `-n` lists exactly the needed finest runs; with those present the dataset is built,
+    extrapolating the other points from two sizes, and nothing is left to do."""
+    import json
+
+    import yaml
+
+    from plough.fingerprint import solver_fingerprint
+    from plough.study import matrix, skipping
+    from tests.study.test_mpm_figures import fake_run
+
+    work = tmp_path / "wf"
+    work.mkdir()
+    for name in ("Snakefile", "config", "workflow"):
+        src = ROOT / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, work / name)
+    (work / "src").symlink_to(ROOT / "src")
+    cfg = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
+    cfg["mpm"]["skip_finest_tolerance"] = 0.5
+    gated = {r: c for r, c in matrix.skippable_runs(cfg).items() if r in matrix.figure_runs(cfg, "fig15")}
+    scenes = matrix.all_runs(cfg)
+    runs = {}
+    for rid in matrix.figure_runs(cfg, "fig15"):
+        runs[rid] = fake_run(scenes[rid])
+        runs[rid].attrs["solver_fingerprint"] = solver_fingerprint()
+    sizes = matrix.particle_sizes_um(cfg)
+
+    def worst(finest: str) -> float:
+        ex = skipping.two_size_extrapolation(runs[gated[finest][0]], runs[gated[finest][1]], sizes[0], sizes[1])
+        # NaN (a run's sampling error not estimable) never skips: as infinite
+        return max(float("inf") if math.isnan(e["relative_uncertainty"]) else e["relative_uncertainty"]
+                   for e in ex.values())
+
+    spread = sorted(w for w in map(worst, gated) if math.isfinite(w))
+    assert len(spread) >= 2 and spread[0] < spread[-1]
+    cfg["mpm"]["skip_finest_tolerance"] = tol = 0.5 * (spread[0] + spread[-1])
+    (work / "config" / "smoke.yaml").write_text(yaml.safe_dump(cfg))
+    (work / "results" / "runs").mkdir(parents=True)
+    for rid, ds in runs.items():
+        if rid not in gated:
+            ds.to_netcdf(work / "results" / "runs" / f"{rid}.nc")
+
+    def dry() -> tuple[dict[str, int], str]:
+        out = _snakemake(work, "--configfile=config/smoke.yaml", "-n", "results/datasets/fig15.nc")
+        assert out.returncode == 0, (out.stdout + out.stderr)[-3000:]
+        return _job_counts(out.stdout + out.stderr), out.stdout + out.stderr
+
+    counts, text = dry()
+    assert counts.get("mpm_refine") == len(gated) and "mpm_run" not in counts and counts.get("mpm_dataset") == 1
+    assert not any(f"results/runs/{r}.nc" in text for r in gated)
+    out = _snakemake(work, "--configfile=config/smoke.yaml", *[f"results/refinement/{r}.json" for r in gated])
+    assert out.returncode == 0, (out.stdout + out.stderr)[-3000:]
+    needed = [r for r in gated if json.loads((work / "results/refinement" / f"{r}.json").read_text())["run_finest"]]
+    assert needed == [r for r in gated if worst(r) > tol] and 0 < len(needed) < len(gated)
+    counts, text = dry()
+    assert counts.get("mpm_run") == len(needed) and "mpm_refine" not in counts
+    assert all(f"results/runs/{r}.nc" in text for r in needed)
+    assert not any(f"results/runs/{r}.nc" in text for r in gated if r not in needed)
+    for rid in needed:  # stand-ins for the needed finest runs
+        runs[rid].to_netcdf(work / "results" / "runs" / f"{rid}.nc")
+    out = _snakemake(work, "--configfile=config/smoke.yaml", "results/datasets/fig15.nc")
+    assert out.returncode == 0, (out.stdout + out.stderr)[-3000:]
+    ds = xr.load_dataset(work / "results/datasets/fig15.nc")
+    assert int(ds["skipped_finest"].sum()) == len(gated) - len(needed)
+    assert "not needed" in (work / "logs/datasets/fig15.log").read_text()
+    counts, _ = dry()
+    assert counts == {}  # nothing left to do

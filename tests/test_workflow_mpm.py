@@ -104,7 +104,10 @@ def test_full_matrix_dry_run_schedules_every_run_once(tmp_path):
     out = _snakemake(work, "-n", timeout=300)
     assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
     counts = _job_counts(out.stdout + out.stderr)
-    assert counts["mpm_run"] == len(matrix.all_runs(FULL))
+    gated = matrix.skippable_runs(FULL)  # refinement only where needed is on in config/config.yaml
+    assert gated and FULL["mpm"]["skip_finest_tolerance"] is not None
+    assert counts["mpm_run"] == len(matrix.all_runs(FULL)) - len(gated)  # a gated finest run waits for its decision
+    assert counts["mpm_refine"] == len(gated)
     assert counts["mpm_dataset"] == len(matrix.MPM_FIGURES) + 1  # and Fig. 22's
     assert counts["figure"] == len(matrix.MPM_FIGURES) + 3  # and Figs. 3, 4, 22
     assert "numba_warmup" not in counts  # each run job compiles numba's kernels when needed, under a lock
@@ -112,10 +115,12 @@ def test_full_matrix_dry_run_schedules_every_run_once(tmp_path):
 
 
 @pytest.mark.slow
-def test_smoke_skip_finest_writes_markers_where_the_coarser_sizes_agree(tmp_path):
-    """mpm.skip_finest_tolerance end to end on Fig. 15: the coarser runs first, then a tolerance
-    between the points' two-size uncertainties, so that some finest runs are skipped and some run;
-    each decision follows plough.study.skipping from the run files, and the dataset says which."""
+def test_smoke_refinement_makes_the_finest_run_only_where_the_coarser_sizes_do_not_agree(tmp_path):
+    """Refinement only where needed end to end on Fig. 15 (the checkpoint mpm_refine): the coarser runs first,
+    then a tolerance between the points' two-size uncertainties, so that some finest runs are needed and some
+    not. Before running, `snakemake -n` lists every decision and no gated finest run; each decision follows
+    plough.study.skipping from the run files; a finest run is made exactly where its decision asks; the dataset
+    says which points were extrapolated from two sizes; a picture's finest run always runs."""
     from plough.study import skipping
 
     work = _project_copy(tmp_path)
@@ -129,31 +134,48 @@ def test_smoke_skip_finest_writes_markers_where_the_coarser_sizes_agree(tmp_path
     def worst(stem: str) -> float:
         runs = [xr.load_dataset(work / f"results/runs/{stem}_h{matrix.fmt(h)}.nc") for h in sizes[:2]]
         ex = skipping.two_size_extrapolation(*runs, sizes[0], sizes[1])
-        return max(e["relative_uncertainty"] for e in ex.values())
+        # NaN (a run's sampling error not estimable) never skips: as infinite
+        return max(float("inf") if math.isnan(e["relative_uncertainty"]) else e["relative_uncertainty"]
+                   for e in ex.values())
 
     cfg = copy.deepcopy(SMOKE)
     cfg["mpm"]["skip_finest_tolerance"] = 0.5
-    skippable = matrix.skippable_runs(cfg)
-    spread = sorted(worst(s) for r, s in zip(finest_ids, stems, strict=True) if r in skippable)
+    gated = matrix.skippable_runs(cfg)
+    spread = sorted(w for r, s in zip(finest_ids, stems, strict=True) if r in gated and math.isfinite(w := worst(s)))
     assert len(spread) >= 2 and spread[0] < spread[-1]
     tol = 0.5 * (spread[0] + spread[-1])  # the smoke sizes are coarse: this may exceed 1
     cfg["mpm"]["skip_finest_tolerance"] = tol
     (work / "config" / "smoke.yaml").write_text(yaml.safe_dump(cfg))
+    in_fig = [r for r in finest_ids if r in gated]
+    assert in_fig and len(in_fig) < len(finest_ids)  # the smoke's Fig. 15 has a picture's run too
+
+    plan = _snakemake(work, "--configfile=config/smoke.yaml", "-n", "results/datasets/fig15.nc")
+    assert plan.returncode == 0, (plan.stdout + plan.stderr)[-4000:]
+    counts = _job_counts(plan.stdout + plan.stderr)
+    assert counts["mpm_refine"] == len(in_fig)
+    assert counts["mpm_run"] == len(finest_ids) - len(in_fig)  # the pictures' finest runs: never gated
+    assert not any(f"results/runs/{r}.nc" in plan.stdout for r in in_fig)
+
     out = _snakemake(work, "--configfile=config/smoke.yaml", "results/datasets/fig15.nc")
     assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
-
     ds = xr.load_dataset(work / "results/datasets/fig15.nc")
     n_skipped = 0
     for rid, stem in zip(finest_ids, stems, strict=True):
-        run = xr.load_dataset(work / "results/runs" / f"{rid}.nc")
-        expect = rid in skippable and worst(stem) <= tol  # a picture's run always runs
-        assert skipping.is_skipped(run) == expect, rid
-        log = (work / "logs/runs" / f"{rid}.log").read_text()
-        assert ("two-size extrapolation" in log) == (rid in skippable), rid  # decided from the coarser runs
-        n_skipped += expect
-    assert 0 < n_skipped < len(finest_ids)
+        made = (work / "results/runs" / f"{rid}.nc").exists()
+        if rid not in gated:
+            assert made, rid
+            continue
+        decision = json.loads((work / "results/refinement" / f"{rid}.json").read_text())
+        expect_skip = worst(stem) <= tol
+        assert decision["run_finest"] == (not expect_skip) == made, rid
+        assert decision["coarser_sizes_um"] == list(sizes[:2])
+        assert decision["reason"] in (work / "logs/refinement" / f"{rid}.log").read_text()
+        n_skipped += expect_skip
+    assert 0 < n_skipped < len(in_fig)
     assert int(ds["skipped_finest"].sum()) == n_skipped
     assert np.isfinite(ds["mu_h0"].values).all() and np.isfinite(ds["dp_h0"].values).all()
+    again = _snakemake(work, "--configfile=config/smoke.yaml", "-n", "results/datasets/fig15.nc")
+    assert "Nothing to be done" in again.stdout + again.stderr, (again.stdout + again.stderr)[-3000:]
 
 
 class _Namespace:

@@ -144,3 +144,50 @@ def test_the_disc_zone_is_the_square_zone_less_its_corners():
 def test_an_unknown_fine_zone_shape_is_refused():
     with pytest.raises(ValueError, match=r"fine_zone_shape = 'circle' is not one of \['square', 'disc'\]"):
         replace(coated_scene().discretisation, fine_zone_shape="circle")
+
+
+@pytest.mark.parametrize("shape", ["square", "disc"])
+def test_a_fine_zone_shaped_by_the_groove_and_the_coating(shape):
+    """fine_zone_depth_particles = m: the zone keeps its half-width w (k expected contact radii) but reaches only
+    max(expected groove, coating) + m h deep (at least 6 h, at most w); every lattice particle of that zone is
+    kept, no merged particle reaches into it, mass and volume are kept, and fewer particles remain than with
+    the zone as deep as wide."""
+    base = graded(coated_scene(), k=1.5, shape=shape)  # t = 25 um, h = 10 um
+    m = 3.0
+    scene = replace(base, discretisation=replace(base.discretisation, fine_zone_depth_particles=m))
+    h = scene.discretisation.particle_size_m
+    a, dp = scene.expected_contact()
+    w = max(1.5 * a, 6 * h)
+    d = min(w, max(max(dp, scene.layers.coating_thickness_m) + m * h, 6 * h))
+    assert d < w - 2 * h  # the zone is shallower than wide: the test tells the two apart
+    u = solver.init(replace(base, discretisation=replace(base.discretisation, graded=False)), n_chunks=1)[0].particles
+    deep = solver.init(base, n_chunks=1)[0].particles
+    g = solver.init(scene, n_chunks=1)[0].particles
+    assert g.n < deep.n
+    assert g.vol0.sum() == pytest.approx(u.vol0.sum(), rel=1e-12)
+    assert g.mass.sum() == pytest.approx(u.mass.sum(), rel=1e-12)
+
+    def zone(x: np.ndarray, half_edge: float) -> np.ndarray:
+        gap_y = np.maximum(np.abs(x[:, 1]) - half_edge, 0.0)
+        gap_z = np.maximum(-x[:, 2] - half_edge, 0.0)
+        if shape == "square":
+            return (gap_y <= w) & (gap_z <= d)
+        return (gap_y / w) ** 2 + (gap_z / d) ** 2 <= 1.0
+
+    fine = np.isclose(g.vol0, h**3, rtol=1e-12, atol=0)
+    coarse = np.isclose(g.vol0, 8 * h**3, rtol=1e-12, atol=0)
+    key = lambda x: set(map(tuple, np.rint(x / (0.5 * h)).astype(np.int64)))  # noqa: E731
+    assert key(u.x[zone(u.x, 0.5 * h)]) <= key(g.x[fine])
+    assert not np.any(zone(g.x[coarse], h - 1e-12))
+    assert np.any(coarse & (np.abs(g.x[:, 1]) < 0.5 * w) & (g.x[:, 2] < -d - h))  # coarse under the track now
+
+
+def test_the_fine_zone_depth_key_is_validated_and_round_trips():
+    disc = coated_scene().discretisation
+    for m in (0.0, 1.5, -3.0, float("nan"), float("inf"), True):
+        with pytest.raises(ValueError, match=r"fine_zone_depth_particles = .* outside the allowed range \[2, inf\) "
+                                             "or null"):
+            replace(disc, fine_zone_depth_particles=m)
+    scene = replace(coated_scene(), discretisation=replace(disc, graded=True, fine_zone_depth_particles=6))
+    assert Scene.from_dict(scene.to_dict()).discretisation.fine_zone_depth_particles == 6
+    assert coated_scene().discretisation.fine_zone_depth_particles is None  # default: as deep as wide

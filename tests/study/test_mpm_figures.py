@@ -514,21 +514,22 @@ def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):
     xr.testing.assert_identical(a, b)
 
 
-def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_files, tmp_path):
-    """A skip marker at the finest size: that point's h -> 0 value is the two-size Richardson
-    extrapolation (order 1, safety factor 3), flagged; its finest per-size values are missing (NaN,
-    declared), every other point is untouched; the dataset passes the atomic writer and draws."""
-    from plough.study import skipping
-
+def test_a_finest_run_its_decision_did_not_ask_for_is_extrapolated_from_the_two_coarser_sizes(run_files, tmp_path):
+    """A gated finest run that its refinement decision did not ask for (not_needed, the checkpoint mpm_refine) is
+    not read: that point's h -> 0 value is the two-size Richardson extrapolation (order 1, safety factor 3),
+    flagged; its finest per-size values are missing (NaN, declared), every other point is untouched; the dataset
+    passes the atomic writer and draws. A run the config does not gate is refused as not needed."""
     loads, r1, finest = _zinc_block_lightest()
-    paths = _with_marker(run_files, tmp_path, finest, skipping.skip_marker(SCENES[finest], {}, 0.1, []))
+    paths = {rid: path for rid, path in run_files.items() if rid != finest}
 
-    with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
-        build_dataset(SMOKE, "fig15", paths)  # skip_finest_tolerance null: a marker is a stale file
+    with pytest.raises(ValueError, match=f"run '{finest}' is named as not needed .* the config does not gate it"):
+        build_dataset(SMOKE, "fig15", paths, not_needed=[finest])  # skip_finest_tolerance null: nothing gated
+    with pytest.raises(FileNotFoundError, match=finest):
+        build_dataset(SMOKE, "fig15", paths)
     config = copy.deepcopy(SMOKE)
     config["mpm"]["skip_finest_tolerance"] = 0.05
     assert finest in matrix.skippable_runs(config)
-    ds = build_dataset(config, "fig15", paths)
+    ds = build_dataset(config, "fig15", paths, not_needed=[finest])
     sel = {"material": "zinc_block", "load_N": loads[0]}
     sig = signature(loads[0], r1, 0.0, "zinc_bulk", 0.0, "boundary_layer")
     h3, h2 = sorted(SIZES, reverse=True)[:2]  # 20, 14
@@ -549,18 +550,30 @@ def test_a_skipped_finest_run_is_extrapolated_from_the_two_coarser_sizes(run_fil
     _draws("fig15", _written(ds, tmp_path), tmp_path)
 
 
-def test_a_skip_marker_at_a_coarser_size_is_refused(run_files, tmp_path):
+def _old_skip_marker(scene: dict) -> xr.Dataset:
+    """A skip marker as the workflow wrote one before refinement became a checkpoint."""
+    from plough.io import provenance_attrs
     from plough.study import skipping
 
+    return xr.Dataset(attrs={skipping.SKIPPED_ATTR: 1, "skip_reason": "within skip_finest_tolerance = 0.1",
+                             **provenance_attrs(scene, key="scene")})
+
+
+@pytest.mark.parametrize("finest", [False, True])
+def test_an_old_skip_marker_is_refused_with_the_command_that_remakes_it(run_files, tmp_path, finest):
+    """The workflow no longer writes skip markers; one left in results/runs/ (at any size, gated or not) is
+    refused, naming the run and the --forcerun command."""
     real = MPM["real_materials"]
-    point = matrix.real_point(real, "steel", float(real["loads_N"][0]), float(real["ball_radii_um"][0]))
-    rid = matrix.run_id(point, max(SIZES))
+    point = matrix.real_point(real, "zinc_block", float(real["loads_N"][0]), float(real["ball_radii_um"][0]))
+    rid = matrix.run_id(point, (min if finest else max)(SIZES))
     paths = dict(run_files)
     paths[rid] = tmp_path / f"{rid}.nc"
-    write_netcdf_atomic(skipping.skip_marker(SCENES[rid], {}, 0.1, []), paths[rid])
+    write_netcdf_atomic(_old_skip_marker(SCENES[rid]), paths[rid])
     config = copy.deepcopy(SMOKE)
     config["mpm"]["skip_finest_tolerance"] = 0.05
-    with pytest.raises(ValueError, match="is a skip marker, but the config does not allow"):
+    assert (rid in matrix.skippable_runs(config)) == finest
+    with pytest.raises(ValueError, match=f"run '{rid}' is a skip marker, which this workflow no longer writes.*"
+                                         f"--forcerun results/runs/{rid}.nc"):
         build_dataset(config, "fig15", paths)
 
 
@@ -790,6 +803,6 @@ def test_a_marker_at_a_pictures_run_is_refused_naming_it(run_files, tmp_path):
     paths = _with_marker(run_files, tmp_path, rid, marker)
     with pytest.raises(ValueError, match=f"run '{rid}' is a failure marker .*a particle left the grid.*fig19 draws"):
         build_dataset(SMOKE, "fig19", paths)
-    write_netcdf_atomic(skipping.skip_marker(SCENES[rid], {}, 0.1, ["a.nc"]), paths[rid])
-    with pytest.raises(ValueError, match=f"run '{rid}' is a skip marker"):
+    write_netcdf_atomic(_old_skip_marker(SCENES[rid]), paths[rid])
+    with pytest.raises(ValueError, match=f"run '{rid}' is a skip marker.*--forcerun results/runs/{rid}.nc"):
         build_dataset(SMOKE, "fig19", paths)

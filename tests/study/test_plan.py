@@ -18,7 +18,7 @@ from plough.cli import main
 from plough.io import to_json
 from plough.mpm.scene import Scene
 from plough.study import cost, matrix
-from plough.study.plan import Measured, Rates, load_config, make_plan, measured_from_benchmarks, merge
+from plough.study.plan import Measured, Rates, _hours, load_config, make_plan, measured_from_benchmarks, merge
 
 ROOT = Path(__file__).resolve().parents[2]
 SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
@@ -101,6 +101,33 @@ def test_benchmark_files_of_the_configs_runs_calibrate_markers_do_not(tmp_path):
     rows = measured_from_benchmarks(tmp_path, runs, threads=2)
     assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 1)]
     assert rows[0].particle_steps == cost.estimate(runs[made]).particle_steps
+
+
+def test_the_plan_states_the_range_refinement_only_where_needed_leaves(tmp_path):
+    """Gated finest runs (mpm.skip_finest_tolerance) are made only where their decision asks: the plan counts each
+    decision made (results/refinement/<run>.json) as it says, and an undecided one at both ends of a range."""
+    from plough.study.plan import describe
+
+    config = copy.deepcopy(SMOKE)
+    assert make_plan(config, directory=tmp_path).gated == {}  # off: every run counted, no range
+    config["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
+    gated = sorted(matrix.skippable_runs(config))
+    needed, not_needed = gated[:2], gated[2:4]
+    (tmp_path / "results" / "refinement").mkdir(parents=True)
+    for rid in needed + not_needed:
+        (tmp_path / "results" / "refinement" / f"{rid}.json").write_text(json.dumps({"run_finest": rid in needed}))
+    (tmp_path / "results" / "refinement" / f"{gated[4]}.json").write_text("{not json")  # unreadable: undecided
+    plan = make_plan(config, directory=tmp_path)
+    assert plan.gated == {rid: True if rid in needed else False if rid in not_needed else None for rid in gated}
+    every = list(plan.runs)
+    high, low = plan.made(every, undecided=True), plan.made(every, undecided=False)
+    assert set(every) - set(high) == set(not_needed)
+    assert set(every) - set(low) == set(gated) - set(needed)
+    text = describe(plan)
+    assert (f"{len(gated)} gated finest runs (2 decided needed, 2 decided not, {len(gated) - 4} undecided): between "
+            f"**{_hours(plan.wall_s(low))}** ({len(low)} runs") in text
+    assert f"and {_hours(plan.wall_s(high))} ({len(high)} runs" in text
+    assert "skip_finest_tolerance: mu 0.05, dp 0.3" in text
 
 
 def test_plough_plan_prints_every_figure_and_the_total(capsys, tmp_path):

@@ -1,4 +1,4 @@
-"""plough.study.skipping: the decision to skip the finest size, the marker, the skippable runs."""
+"""plough.study.skipping: the refinement decision (is a point's finest size needed?), the gated runs."""
 
 from __future__ import annotations
 
@@ -32,11 +32,20 @@ def test_two_size_extrapolation_is_richardson_order_one_with_safety_factor_three
     assert skipping.should_skip(converged, 1e-6)
 
 
-@pytest.mark.parametrize("tol", [0.0, -0.1, float("nan"), float("inf")])
+@pytest.mark.parametrize("tol", [0.0, -0.1, float("nan"), float("inf"), True, {"mu": 0.05}, {"mu": 0.05, "dp": 0.0},
+                                 {"mu": 0.05, "dp": 0.3, "hpu": 0.1}])
 def test_tolerance_outside_its_range_is_refused(tol):
     ex = skipping.two_size_extrapolation(_run(0.4, 5e-6), _run(0.4, 5e-6), 20.0, 10.0)
     with pytest.raises(ValueError, match="skip_finest_tolerance"):
         skipping.should_skip(ex, tol)
+
+
+def test_a_tolerance_per_output_decides_each_output_by_its_own():
+    ex = skipping.two_size_extrapolation(_run(0.40, 5e-6), _run(0.44, 6e-6), 20.0, 10.0)  # mu 0.25, dp 0.43
+    assert skipping.tolerances(0.5) == {"mu": 0.5, "dp": 0.5}
+    assert skipping.should_skip(ex, {"mu": 0.25, "dp": 0.45})
+    assert not skipping.should_skip(ex, {"mu": 0.24, "dp": 0.45})
+    assert not skipping.should_skip(ex, {"mu": 0.25, "dp": 0.42})
 
 
 def test_non_finite_uncertainty_never_skips():
@@ -44,19 +53,72 @@ def test_non_finite_uncertainty_never_skips():
     assert not skipping.should_skip(ex, 0.5)
 
 
-def test_marker_carries_provenance_and_no_results():
-    ex = skipping.two_size_extrapolation(_run(0.40, 5e-6), _run(0.44, 6e-6), 20.0, 10.0)
-    m = skipping.skip_marker({"name": "p_h5"}, ex, 0.5, ["a.nc", "b.nc"])
-    assert skipping.is_skipped(m) and not skipping.is_skipped(_run(0.4, 1e-6))
-    assert not m.data_vars
-    assert json.loads(m.attrs["scene"]) == {"name": "p_h5"}
-    assert json.loads(m.attrs["skip_extrapolations"])["mu"]["value"] == pytest.approx(0.48)
-    assert m.attrs["plough_version"] and "a.nc" in m.attrs["skip_reason"]
+def _scene_run(mu: float, dp: float, h_um: float, name: str) -> xr.Dataset:
+    scene = {"name": name, "discretisation": {"particle_size_m": h_um * 1e-6}}
+    return _run(mu, dp).assign_attrs(scene=json.dumps(scene))
+
+
+def test_the_decision_reads_the_sizes_the_coarser_runs_record_and_says_why():
+    coarse, mid = _scene_run(0.40, 5e-6, 40.0, "p_h40"), _scene_run(0.44, 6e-6, 20.0, "p_h20")
+    d = skipping.decide("p_h10", coarse, mid, ["p_h40", "p_h20"], {"mu": 0.3, "dp": 0.45})
+    assert d["run_finest"] is False and d["finest_run"] == "p_h10" and d["coarser_sizes_um"] == [40.0, 20.0]
+    assert d["extrapolations"]["mu"]["value"] == pytest.approx(0.48, rel=1e-12)
+    assert d["tolerance"] == {"mu": 0.3, "dp": 0.45}
+    assert "p_h40, p_h20 (h = 40, 20 um) is within" in d["reason"]
+    assert json.loads(json.dumps(d)) == d  # the checkpoint writes it as JSON
+    needed = skipping.decide("p_h10", coarse, mid, ["p_h40", "p_h20"], 0.3)
+    assert needed["run_finest"] is True and "is not within" in needed["reason"]
+
+
+def test_the_decision_of_a_relative_ladder_point_uses_its_own_sizes(tmp_path):
+    """The refinement checkpoint (workflow/scripts/mpm_refine.py) of a relative-ladder point whose sizes are not
+    the config's extrapolates at the point's own two coarser sizes (matrix.coarser_sizes_um), read from the run
+    files. (Before, the skip decision got the config's sizes from the rule, mpm.smk's
+    particle_sizes_um(config)[-3:-1]: right by chance, as the two-size extrapolation depends on their ratio only,
+    but named wrong in the log.)"""
+    import runpy
+    import sys
+
+    from plough.fingerprint import solver_fingerprint
+    from tests.study.test_mpm_figures import fake_run
+
+    cfg = copy.deepcopy(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
+    cfg["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
+    gated = matrix.skippable_runs(cfg)
+    finest = next(r for r in gated if matrix.coarser_sizes_um(cfg, r) != list(matrix.particle_sizes_um(cfg)[-3:-1]))
+    coarse, mid = gated[finest]
+    scenes = matrix.all_runs(cfg)
+    paths = []
+    for rid in (coarse, mid):
+        ds = fake_run(scenes[rid])
+        ds.attrs["solver_fingerprint"] = solver_fingerprint()
+        paths.append(str(tmp_path / f"{rid}.nc"))
+        ds.to_netcdf(paths[-1])
+
+    class NS:
+        def __init__(self, **kw):
+            self.__dict__.update(kw)
+
+    out = tmp_path / "refinement" / f"{finest}.json"
+    smk = NS(params=NS(tolerance=cfg["mpm"]["skip_finest_tolerance"], coarser=[coarse, mid],
+                       solver=solver_fingerprint()),
+             input=NS(coarser=paths), output=[str(out)], log=[str(tmp_path / "refine.log")], config=cfg,
+             wildcards=NS(run=finest))
+    stderr = sys.stderr
+    runpy.run_path(str(ROOT / "workflow" / "scripts" / "mpm_refine.py"), init_globals={"snakemake": smk})
+    assert sys.stderr is stderr
+    decision = json.loads(out.read_text())
+    assert decision["coarser_sizes_um"] == matrix.coarser_sizes_um(cfg, finest)
+    assert decision["finest_run"] == finest and decision["coarser_runs"] == [coarse, mid]
+    assert decision["reason"] in (tmp_path / "refine.log").read_text()
 
 
 def test_skippable_runs_are_finest_sweep_runs_never_pictures():
     assert matrix.skippable_runs(SMOKE) == {}  # off by default
     cfg = copy.deepcopy(SMOKE)
+    cfg["mpm"]["skip_finest_tolerance"] = {"mu": 0.05}
+    with pytest.raises(ValueError, match="skip_finest_tolerance .* must be a number or name each of mu, dp"):
+        matrix.skippable_runs(cfg)
     cfg["mpm"]["skip_finest_tolerance"] = 0.05
     skippable = matrix.skippable_runs(cfg)
     sizes = matrix.particle_sizes_um(cfg)
@@ -117,7 +179,7 @@ def test_failure_recordable_runs_follow_mpm_finest_failure():
     """record (the default, also when the key is absent): every finest sweep run that is not a picture's,
     the same runs skipping may skip; stop: none; an unknown choice is refused by name."""
     with_skip = copy.deepcopy(SMOKE)
-    with_skip["mpm"]["skip_finest_tolerance"] = 0.05
+    with_skip["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
     record = copy.deepcopy(SMOKE)
     record["mpm"]["finest_failure"] = "record"
     assert matrix.failure_recordable_runs(record) == matrix.skippable_runs(with_skip) != {}

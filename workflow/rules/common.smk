@@ -7,8 +7,11 @@
 # takes no source file as input. The code trigger (a script newer than its outputs) is off
 # (profiles/default, the workflow profile Snakemake reads by itself); the cheap rules take the
 # package source and their script as inputs instead, so an edit still redoes them.
+import json
 import re
 from pathlib import Path
+
+from snakemake.exceptions import IncompleteCheckpointException
 
 from plough.fingerprint import files_fingerprint, solver_fingerprint
 from plough.mpm.scene import Scene
@@ -20,7 +23,7 @@ SCRIPTS = Path(workflow.basedir, "workflow", "scripts")
 # the solver the jobs import (the installed plough), and the run job's own code without comments
 SOLVER_FINGERPRINT = solver_fingerprint()
 RUN_SCRIPT_FINGERPRINT = files_fingerprint([SCRIPTS / "mpm_run.py"], SCRIPTS)
-# a skippable run's decision (plough.study.skipping) reads the two coarser runs' extrapolation
+# a gated finest run's refinement decision (plough.study.skipping) reads the two coarser runs' extrapolation
 SKIP_DECISION_FINGERPRINT = files_fingerprint(
     [Path(matrix.__file__).with_name(n) for n in ("skipping.py", "extrapolation.py")], Path(matrix.__file__).parent)
 
@@ -34,9 +37,35 @@ MPM_RUNS = matrix.all_runs(config)
 MPM_THREADS = int(config["mpm"]["threads"])
 # particles and steps of every run, for the memory and wall-time requests of cluster jobs
 MPM_COST = {rid: cost.estimate(Scene.from_dict(scene)) for rid, scene in MPM_RUNS.items()}
-# finest-size runs that may be skipped (mpm.skip_finest_tolerance): run id -> its two coarser runs
+# finest-size runs made only where needed (mpm.skip_finest_tolerance, checkpoint mpm_refine): run id -> its
+# two coarser runs
 SKIPPABLE = matrix.skippable_runs(config)
 SKIP_TOLERANCE = config["mpm"].get("skip_finest_tolerance")
+
+
+def refinement_needed(decision_file):
+    """Whether a refinement decision (results/refinement/<finest run>.json) asks for its finest run."""
+    return bool(json.loads(Path(decision_file).read_text())["run_finest"])
+
+
+def dataset_inputs(wc):
+    """The run files a figure's dataset reads and the refinement decisions it follows (checkpoint mpm_refine,
+    mpm.smk): a gated finest run (SKIPPABLE) only once its decision says it is needed. Until a decision is
+    made its file (the checkpoint's target) stands in, caught here rather than raised, so that every decision
+    of the figure is scheduled at once and the dataset is re-planned as each one lands."""
+    runs = runs_of(wc.figure)
+    decisions = []
+    for finest in [r for r in runs if r in SKIPPABLE]:
+        try:
+            path = checkpoints.mpm_refine.get(run=finest).output[0]
+        except IncompleteCheckpointException as undecided:
+            decisions.append(undecided.targetfile)
+            del runs[finest]
+            continue
+        decisions.append(path)
+        if not refinement_needed(path):
+            del runs[finest]
+    return {"runs": list(runs.values()), "decisions": decisions}
 
 
 def runs_of(figure):

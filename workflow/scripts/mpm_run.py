@@ -9,9 +9,8 @@ numba compiles the kernels into its cache on first use, and parallel first compi
 changed (results/.numba_warm records their times and sizes, numba's own cache key, with numba's and
 Python's versions) compiles them with a tiny scene while the other jobs wait on a lock.
 
-A finest-size run with ``params.skip_tolerance`` set first extrapolates its point's two coarser
-runs (each checked against its run); within the tolerance it writes a skip marker instead of running
-(plough.study.skipping).
+Whether a gated finest run is needed at all is decided before it is scheduled (workflow/scripts/mpm_refine.py,
+the checkpoint mpm_refine); this job only runs.
 A finest sweep run that stops unstable (``InstabilityError``: not a refused scene, a load it cannot
 reach or lost contact) writes a failure marker instead of failing the job when the
 config's ``mpm.finest_failure`` is ``record`` (read here, not a param, so that changing it does not
@@ -33,7 +32,7 @@ from plough.mpm.run import simulate, warm_up
 from plough.mpm.scene import Scene
 from plough.mpm.solver import InstabilityError
 from plough.study import matrix, skipping
-from plough.study.runfiles import SOLVER_ATTR, RunFileError, load_run
+from plough.study.runfiles import SOLVER_ATTR
 
 smk = snakemake  # noqa: F821 - injected by Snakemake
 SOLVER = solver_fingerprint()
@@ -53,25 +52,6 @@ def warm_numba(log) -> None:
         stamp.write_text(key)
 
 
-def skipped(log) -> bool:
-    """Write the skip marker and say so when the two coarser runs extrapolate within the tolerance."""
-    if smk.params.skip_tolerance is None:
-        return False
-    scenes = matrix.all_runs(smk.config)
-    coarse, mid = (load_run(p, Path(p).stem, scenes.get(Path(p).stem), SOLVER) for p in smk.input.coarser)
-    h_coarse, h_mid = smk.params.coarser_sizes_um
-    ex = skipping.two_size_extrapolation(coarse, mid, h_coarse, h_mid)
-    print(f"two-size extrapolation of h = {h_coarse:g}, {h_mid:g} um: {ex}", file=log)
-    if not skipping.should_skip(ex, smk.params.skip_tolerance):
-        return False
-    marker = skipping.skip_marker(smk.params.scene, ex, smk.params.skip_tolerance, list(smk.input.coarser))
-    marker.attrs[SOLVER_ATTR] = SOLVER
-    write_netcdf_atomic(marker, smk.output[0])
-    print(f"skipped (within skip_finest_tolerance = {smk.params.skip_tolerance:g}): wrote the marker "
-          f"{smk.output[0]}", file=log)
-    return True
-
-
 def run(log) -> None:
     if SOLVER != smk.params.solver:
         raise RuntimeError(f"this job's solver ({SOLVER}, plough in {solver_files()[0].parents[1]}) is not the one "
@@ -79,8 +59,6 @@ def run(log) -> None:
                            "snakemake started, or the jobs import another plough than snakemake does; rerun snakemake "
                            "(from the Python environment its jobs use)")
     scene = Scene.from_dict(smk.params.scene)
-    if skipped(log):
-        return
     warm_numba(log)
     try:
         ds = simulate(scene, progress=True, threads=smk.threads)
@@ -104,8 +82,4 @@ def run(log) -> None:
 # the progress bar (sliding distance, ETA, Fx/Fz) goes to logs/runs/<run>.log; stderr is given back before the
 # log closes, so that a failing run's traceback reaches Snakemake's output (not "lost sys.stderr")
 with open(smk.log[0], "w", buffering=1) as log, contextlib.redirect_stderr(log):
-    try:
-        run(log)
-    except RunFileError as exc:  # a coarser run that is not its run: one line, naming it
-        print(f"\n{exc}", file=log)
-        sys.exit(str(exc))
+    run(log)

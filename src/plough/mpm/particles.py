@@ -8,7 +8,8 @@ fraction ``frac_a`` (density, elastic moduli and flow stress are volume-weighted
 :mod:`plough.mpm.constitutive`). Pure particles have ``frac_a = 1`` and ``mat_b = mat_a``.
 
 Graded particles (``discretisation.graded``): outside the fine zone along the track (k expected
-contact radii wide and deep, at least 6 h), each complete
+contact radii wide and, unless ``fine_zone_depth_particles`` shapes its depth by the groove and the
+coating, as deep; at least 6 h), each complete
 2 x 2 x 2 group of lattice cubes (all eight inside the half cylinder) becomes one particle of edge
 2 h at the group's centre, with the group's volume, mass and coating volume fraction, so the block's
 mass, volume, coating volume and centre of mass are those of the uniform lattice exactly. A
@@ -64,7 +65,8 @@ def seed_particles(scene: Scene, material_rows: dict[str, int], table: np.ndarra
     n = x.shape[0]
     vol0 = np.full(n, h**3)
     if scene.discretisation.graded:
-        x, vol0 = coarsen_far_field(x, h, _fine_half_width(scene), scene.discretisation.fine_zone_shape)
+        x, vol0 = coarsen_far_field(x, h, _fine_half_width(scene), scene.discretisation.fine_zone_shape,
+                                    _fine_depth(scene))
         n = x.shape[0]
 
     t = scene.layers.coating_thickness_m
@@ -129,6 +131,19 @@ def _fine_half_width(scene: Scene) -> float:
     return max(scene.discretisation.fine_zone_contact_radii * a, FINE_ZONE_MIN_PARTICLES * h)
 
 
+def _fine_depth(scene: Scene) -> float:
+    """Depth of the fine zone: its half-width, or with ``fine_zone_depth_particles`` = m the expected groove
+    depth or the coating thickness, whichever is deeper, plus m h, within [6 h, the half-width]."""
+    width = _fine_half_width(scene)
+    m = scene.discretisation.fine_zone_depth_particles
+    if m is None:
+        return width
+    _, dp = scene.expected_contact()
+    h = scene.discretisation.particle_size_m
+    deformed = max(dp, scene.layers.coating_thickness_m if scene.layers.coated else 0.0)
+    return min(width, max(deformed + m * h, FINE_ZONE_MIN_PARTICLES * h))
+
+
 def uniform_particle_count(scene: Scene) -> float:
     """Particles of the uniform h lattice filling the block: its volume (a quarter cylinder with the
     mirror plane, half without) over h^3, within a fraction of a per cent of what is seeded."""
@@ -144,18 +159,20 @@ def particle_count_ratio(scene: Scene) -> float:
         return 1.0
     h = scene.discretisation.particle_size_m
     x = _lattice(scene, 2)
-    coarse = coarsen_far_field(x, h, _fine_half_width(scene), scene.discretisation.fine_zone_shape)[0]
+    coarse = coarsen_far_field(x, h, _fine_half_width(scene), scene.discretisation.fine_zone_shape,
+                               _fine_depth(scene))[0]
     return coarse.shape[0] / x.shape[0]
 
 
-def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float,
-                      shape: str = "square") -> tuple[np.ndarray, np.ndarray]:
+def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float, shape: str = "square",
+                      fine_depth_m: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Merge the lattice particles outside the fine zone into particles of edge 2 h.
 
     ``x`` are the centres of a lattice of cubes of edge h with faces on multiples of h (y and z
     measured from the mirror plane and the surface). A cube is in the fine zone if a point of it
-    is: with ``shape`` "square" where |y| <= ``fine_half_width_m`` and z >= -``fine_half_width_m``,
-    with "disc" where y^2 + z^2 <= ``fine_half_width_m``^2 (z <= 0 in the block); a group of 2 x 2 x 2
+    is: with ``shape`` "square" where |y| <= ``fine_half_width_m`` and z >= -``fine_depth_m``,
+    with "disc" where (y / half-width)^2 + (z / depth)^2 <= 1 (z <= 0 in the block; ``fine_depth_m``
+    None: the half-width, a square or a half disc); a group of 2 x 2 x 2
     cubes (aligned to even multiples of h) is
     merged when all eight of its cubes exist and none lies in the fine zone. Returns the new centres
     (sorted x-major, as the lattice was, so that thread chunks stay slabs of the block) and volumes.
@@ -164,10 +181,13 @@ def coarsen_far_field(x: np.ndarray, h: float, fine_half_width_m: float,
     parent = np.floor_divide(idx, 2)
     gap_y = np.maximum(np.abs(x[:, 1]) - 0.5 * h, 0.0)  # from the cube's nearest point to the track's axis
     gap_z = np.maximum(-x[:, 2] - 0.5 * h, 0.0)
+    depth = fine_half_width_m if fine_depth_m is None else fine_depth_m
     if shape == "square":
-        fine = (gap_y <= fine_half_width_m) & (gap_z <= fine_half_width_m)
-    elif shape == "disc":
+        fine = (gap_y <= fine_half_width_m) & (gap_z <= depth)
+    elif shape == "disc" and fine_depth_m is None:
         fine = gap_y**2 + gap_z**2 <= fine_half_width_m**2
+    elif shape == "disc":
+        fine = (gap_y / fine_half_width_m) ** 2 + (gap_z / depth) ** 2 <= 1.0
     else:
         raise ValueError(f"fine-zone shape {shape!r} is not one of {list(FINE_ZONE_SHAPES)}")
     lo = parent.min(axis=0)

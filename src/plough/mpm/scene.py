@@ -291,6 +291,9 @@ ACTIVE_ZONE_MIN_PARTICLES = 20.0
 #: how J and the pressure see the dilatation rate (see Discretisation)
 DILATATION_MODES = ("projected", "local")
 FINE_ZONE_SHAPES = ("square", "disc")
+#: smallest fine-zone depth below the expected groove or the coating, in particle sizes h: the groove's
+#: bottom and the coating-substrate interface each keep at least two layers of h particles below them
+FINE_ZONE_MIN_DEPTH_PARTICLES = 2.0
 
 
 @dataclass(frozen=True)
@@ -319,6 +322,11 @@ class Discretisation:
     within the half-width) or "disc" (the distance from the track's centre line on the surface
     within it: the corners, about 2 contact radii from the track in both y and depth, are coarse;
     12-16% fewer particles on the reference scenes; docs/journal/2026-11-23-disc-fine-zone.md).
+    ``fine_zone_depth_particles``: when set, the zone's depth follows the deformation instead: the
+    expected groove depth or the coating thickness, whichever is deeper, plus this many particle
+    sizes h (>= 2), never deeper than the half-width (nor shallower than 6 h); the half-width stays
+    ``fine_zone_contact_radii`` expected contact radii. None (default): as deep as wide
+    (docs/journal/2026-12-02-fine-zone-depth.md).
 
     ``active_zone_contact_radii``: when set, only the particles that started within this many
     expected contact radii (and at least 20 h) behind or ahead of the sphere's centre (along the
@@ -339,6 +347,7 @@ class Discretisation:
     graded: bool = False
     fine_zone_contact_radii: float = 1.5
     fine_zone_shape: str = "square"
+    fine_zone_depth_particles: float | None = None
     active_zone_contact_radii: float | None = None
 
     def __post_init__(self) -> None:
@@ -364,6 +373,12 @@ class Discretisation:
         if self.fine_zone_shape not in FINE_ZONE_SHAPES:
             raise ValueError(f"discretisation.fine_zone_shape = {self.fine_zone_shape!r} is not one of "
                              f"{list(FINE_ZONE_SHAPES)}")
+        k = self.fine_zone_depth_particles
+        if k is not None and not (isinstance(k, int | float) and not isinstance(k, bool) and math.isfinite(k)
+                                  and k >= FINE_ZONE_MIN_DEPTH_PARTICLES):
+            raise ValueError(f"discretisation.fine_zone_depth_particles = {k!r} is outside the allowed range "
+                             f"[{FINE_ZONE_MIN_DEPTH_PARTICLES:g}, inf) or null: particles of size h below the "
+                             "expected groove and the coating")
         k = self.active_zone_contact_radii
         if k is not None and not (isinstance(k, int | float) and not isinstance(k, bool) and math.isfinite(k)
                                   and k >= ACTIVE_ZONE_MIN_CONTACT_RADII):

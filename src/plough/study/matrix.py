@@ -140,7 +140,7 @@ _NUMERICS_KEYS = {
     "discretisation.particle_size_m": "mpm.particle_sizes_um",
     **{f"discretisation.{k}": f"mpm.numerics.{k}" for k in (
         "particles_per_cell", "cfl", "mass_scaling", "flip", "dilatation", "graded", "fine_zone_contact_radii",
-        "fine_zone_shape", "active_zone_contact_radii")},
+        "fine_zone_shape", "fine_zone_depth_particles", "active_zone_contact_radii")},
     "sliding.distance_m": "mpm.numerics.sliding_distance_um",
     "sliding.speed_m_s": "mpm.numerics.speed_m_s",
     "sliding.experiment_speed_m_s": "mpm.numerics.experiment_speed_m_s",
@@ -475,6 +475,8 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
                                       graded=numerics.get("graded", False),
                                       fine_zone_contact_radii=float(numerics.get("fine_zone_contact_radii", 1.5)),
                                       fine_zone_shape=str(numerics.get("fine_zone_shape", "square")),
+                                      fine_zone_depth_particles=_optional_float(
+                                          numerics.get("fine_zone_depth_particles")),
                                       active_zone_contact_radii=_optional_float(
                                           numerics.get("active_zone_contact_radii"))),
         outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
@@ -527,11 +529,16 @@ def all_runs(config: dict[str, Any], figures: tuple[str, ...] = MPM_FIGURES) -> 
 
 
 def skippable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
-    """finest-size run id -> (coarsest, middle) run ids of the same point, for the runs that may be
-    skipped (``plough.study.skipping``): empty unless ``mpm.skip_finest_tolerance`` is set and there
-    are at least three sizes; never a run a picture (single-run figure) needs."""
-    if config["mpm"].get("skip_finest_tolerance") is None:
+    """finest-size run id -> (coarsest, middle) run ids of the same point, for the *gated* finest runs, made
+    only where the point's refinement decision asks for them (``plough.study.skipping``): empty unless
+    ``mpm.skip_finest_tolerance`` is set (checked here) and there are at least three sizes; never a run a
+    picture (single-run figure) needs."""
+    from plough.study.skipping import tolerances
+
+    tolerance = config["mpm"].get("skip_finest_tolerance")
+    if tolerance is None:
         return {}
+    tolerances(tolerance)
     return finest_sweep_runs(config)
 
 

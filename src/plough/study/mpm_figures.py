@@ -26,7 +26,7 @@ from plough.io import provenance_attrs
 from plough.mpm.io import STANDARD_ERROR_META, STEADINESS_META, STEADY_META
 from plough.study import matrix
 from plough.study.extrapolation import extrapolate_dataarray, sampling_error
-from plough.study.runfiles import load_run
+from plough.study.runfiles import load_run, remedy
 from plough.study.skipping import is_failed, is_skipped
 
 TITLES = {
@@ -69,12 +69,12 @@ def load_runs(run_ids: list[str], paths: Mapping[str, str | Path], scenes: Mappi
 
 
 def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mapping[str, xr.Dataset],
-                   suffix: str, skippable: Collection[str] = (), recordable: Collection[str] = (),
+                   suffix: str, not_needed: Collection[str] = (), recordable: Collection[str] = (),
                    ladders: Mapping[str, tuple[float, ...]] | None = None) -> xr.Dataset:
     """One panel's per-size values and their h -> 0 extrapolation. ``sizes_um`` descending; a run in
-    ``skippable`` (``matrix.skippable_runs``) may be a skip marker, one in ``recordable``
-    (``matrix.failure_recordable_runs``) a failure marker; any other marker is refused. Either way
-    the point is extrapolated from the two coarser sizes."""
+    ``not_needed`` (gated finest runs their refinement decision did not ask for) is not read, one in
+    ``recordable`` (``matrix.failure_recordable_runs``) may be a failure marker; any other marker is
+    refused. Either way the point is extrapolated from the two coarser sizes."""
     labels = [s.label for s in panel.series]
     ax_units, ax_long = matrix.AXES[panel.axis]
     coords = {
@@ -102,20 +102,20 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
             for k, h in enumerate(own):
                 size[i, j, k] = h
                 rid = matrix.run_id(point, h)
-                ds = runs[rid]
-                if is_skipped(ds):
-                    if rid not in skippable:
-                        raise ValueError(f"run {rid!r} is a skip marker, but the config does not allow skipping it "
-                                         "(mpm.skip_finest_tolerance is null, fewer than three sizes, not the "
-                                         "finest size, or a picture's run); delete the file and rerun")
+                if rid in not_needed:
                     skipped[i, j] = True
                     continue
+                ds = runs[rid]
+                if is_skipped(ds):
+                    raise ValueError(f"run {rid!r} is a skip marker, which this workflow no longer writes (a "
+                                     "finest run is now made only where its refinement decision asks for it); "
+                                     f"{remedy(f'results/runs/{rid}.nc')}")
                 if is_failed(ds):
                     if rid not in recordable:
                         raise ValueError(f"run {rid!r} is a failure marker ({ds.attrs.get('failure_reason')}), but "
                                          "the config does not allow one there (mpm.finest_failure is stop, fewer "
-                                         "than three sizes, not the finest size, or a picture's run); delete the "
-                                         "file and rerun")
+                                         "than three sizes, not the finest size, or a picture's run); "
+                                         f"{remedy(f'results/runs/{rid}.nc')}")
                     failed[i, j] = True
                     continue
                 for o in per_size:
@@ -198,16 +198,19 @@ def _limit_sampling_error(sizes_um: tuple[float, ...], values: np.ndarray, se: n
     return out
 
 
-def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
+def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dataset],
+                  not_needed: Collection[str] = ()) -> xr.Dataset:
+    """A sweep figure's dataset; ``not_needed``: the gated finest runs (``matrix.skippable_runs``) whose
+    refinement decision did not ask for them (any other run named there is refused)."""
     panels = matrix.figure_panels(config, figure)
     sizes = matrix.particle_sizes_um(config)
-    skippable = set(matrix.skippable_runs(config))
+    _check_not_needed(config, not_needed)
     recordable = set(matrix.failure_recordable_runs(config))
     # each point's own sizes (mpm.ladder: relative); the h -> 0 extrapolation runs along the config's sizes,
     # which a point's are times a power of two: Richardson, the GCI, the least-squares fallback and the sampling
     # errors' weights depend on the sizes' ratios only, so the values and uncertainties are those of its own
     ladders = {pt.key: matrix.point_ladder(config, pt).sizes_um for p in panels for s in p.series for pt in s.points}
-    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", skippable, recordable,
+    parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", set(not_needed), recordable,
                             ladders if any(lad != sizes for lad in ladders.values()) else None)
              for p in panels]
     ds = xr.merge(parts, combine_attrs="drop_conflicts", join="exact")
@@ -230,7 +233,7 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
         if is_skipped(run) or is_failed(run):
             reason = run.attrs.get("failure_reason") or run.attrs.get("skip_reason")
             raise ValueError(f"run {rid!r} is a {'failure' if is_failed(run) else 'skip'} marker ({reason}), but "
-                             f"{figure} draws that run itself; delete the file and rerun")
+                             f"{figure} draws that run itself; {remedy(f'results/runs/{rid}.nc')}")
         sub = run[[v for v in keep if v in run]]
         for o in (*matrix.OUTPUTS, "Fz_mean"):
             sub[o] = run[o]
@@ -258,9 +261,18 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
     return ds
 
 
-def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset]) -> xr.Dataset:
+def _check_not_needed(config: dict[str, Any], not_needed: Collection[str]) -> None:
+    wrong = sorted(set(not_needed) - set(matrix.skippable_runs(config)))
+    if wrong:
+        raise ValueError(f"run {wrong[0]!r} is named as not needed by a refinement decision, but the config does not "
+                         "gate it (mpm.skip_finest_tolerance is null, fewer than three sizes, not the finest size, or "
+                         "a picture's run)")
+
+
+def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset],
+                     not_needed: Collection[str] = ()) -> xr.Dataset:
     """The MPM friction of Fig. 21 (h -> 0) on the coordinates Fig. 22's plot expects."""
-    fig21 = sweep_dataset(config, "fig21", runs)
+    fig21 = sweep_dataset(config, "fig21", runs, not_needed)
     radii = [float(x) for x in config["mpm"]["real_materials"]["ball_radii_um"]]
     diam = np.array([2.0 * r / 1000.0 for r in radii])
     mu = fig21["mu_h0"].values
@@ -281,25 +293,28 @@ def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset]) -> 
 
 
 def build_dataset(config: dict[str, Any], figure: str, paths: Mapping[str, str | Path],
-                  solver: str | None = None) -> xr.Dataset:
+                  solver: str | None = None, not_needed: Collection[str] = ()) -> xr.Dataset:
     """The dataset of one MPM figure from its run result files (run id -> path). Each file must hold
     its run's scene as the config makes it and, when ``solver`` is given (the workflow gives the
-    current :func:`plough.fingerprint.solver_fingerprint`), have been made by that solver."""
+    current :func:`plough.fingerprint.solver_fingerprint`), have been made by that solver.
+    ``not_needed``: gated finest runs whose refinement decision did not ask for them (the checkpoint
+    ``mpm_refine``): not read, their points extrapolated from the two coarser sizes."""
     if figure != "fig22" and figure not in matrix.MPM_FIGURES:
         raise ValueError(f"figure = {figure!r} is not an MPM figure; allowed: {matrix.MPM_FIGURES}")
+    _check_not_needed(config, not_needed)
     scenes = matrix.all_runs(config, ("fig21",) if figure == "fig22" else (figure,))
-    runs = load_runs(matrix.figure_runs(config, figure), paths, scenes, solver)
+    runs = load_runs([r for r in matrix.figure_runs(config, figure) if r not in not_needed], paths, scenes, solver)
     if figure == "fig22":
         from plough.study.analytical_figures import fig22_dataset
 
-        ds = xr.merge([fig22_dataset(config["power_law"]), fig22_mpm_points(config, runs)],
+        ds = xr.merge([fig22_dataset(config["power_law"]), fig22_mpm_points(config, runs, not_needed)],
                       combine_attrs="override")
         ds.attrs.update(provenance_attrs(config))
         return ds
     if figure in matrix.SINGLE_RUN_FIGURES:
         ds = single_run_dataset(config, figure, runs)
     elif figure in matrix.SWEEP_FIGURES:
-        ds = sweep_dataset(config, figure, runs)
+        ds = sweep_dataset(config, figure, runs, not_needed)
     else:
         raise ValueError(f"figure = {figure!r} is not an MPM figure; allowed: {matrix.MPM_FIGURES}")
     scene_attrs = {k: v for k, v in ds.attrs.items()

@@ -23,7 +23,13 @@ slowest rate measured for workflow jobs here. On a cluster each run is one job w
 (``set-threads: mpm_run``), its time scaled linearly from the time here, and its request the profile's
 (:func:`plough.study.cost.runtime_minutes`). What this leaves out: the analytical figures and the datasets
 (seconds each), the machine's drift (whole-run times vary by up to 30% between invocations,
-docs/performance.md), and a finest run that is skipped or stops (counted in full).
+docs/performance.md), and a finest run that stops (counted in full).
+
+Refinement only where needed (``mpm.skip_finest_tolerance``; the workflow's checkpoint ``mpm_refine``):
+whether a gated finest run is made is known only once its point's two coarser runs are, so the plan
+states a range: every gated finest run made (the upper end, the tables' figures) and every one not
+yet decided skipped (the lower end). Decisions already made (``results/refinement/<run>.json`` under
+the workflow's directory) are followed at both ends.
 """
 
 from __future__ import annotations
@@ -33,13 +39,15 @@ import csv
 import json
 import math
 from collections.abc import Iterable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 #: where the measured calibration lives, relative to the working directory (the repository root)
 CALIBRATION_FILES = "benchmarks/results/projection_check_*.json"
 RUN_BENCHMARKS = "benchmarks/runs"
+#: the refinement decisions of the workflow's checkpoint mpm_refine, relative to its directory
+DECISIONS = "results/refinement"
 BASE_CONFIG = "config/config.yaml"
 FAMILIES = ("rigid-plastic", "real materials")
 #: every figure the workflow draws; the analytical ones (and Fig. 22's fits) need no MPM run of their own
@@ -193,6 +201,13 @@ class Plan:
     measured: list[Measured]
     runs: dict[str, RunPlan]
     figures: dict[str, list[str]]
+    #: gated finest run -> its refinement decision: True needed, False not, None not yet made
+    gated: dict[str, bool | None] = field(default_factory=dict)
+
+    def made(self, runs: Iterable[str], *, undecided: bool) -> list[str]:
+        """The runs of ``runs`` the workflow makes, each undecided gated finest run counted as ``undecided``."""
+        return [r for r in runs if r not in self.gated
+                or (self.gated[r] if self.gated[r] is not None else undecided)]
 
     @property
     def parallel_jobs(self) -> int:
@@ -241,7 +256,21 @@ def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path =
         runs[rid] = RunPlan(rid, family, h, c.particle_steps, c.memory_mb, here, here * threads / cluster,
                             cost.runtime_minutes(c, cluster))
     figures = {fig: [r for r in matrix.figure_runs(config, fig) if r in runs] for fig in ALL_FIGURES}
-    return Plan(config, threads, cores, cluster, rates, measured, runs, figures)
+    return Plan(config, threads, cores, cluster, rates, measured, runs, figures,
+                decisions(directory, matrix.skippable_runs(config)))
+
+
+def decisions(directory: Path, gated: Iterable[str]) -> dict[str, bool | None]:
+    """gated finest run -> its refinement decision under ``directory`` (``results/refinement/<run>.json``:
+    True needed, False not), None where none is made (or it cannot be read)."""
+    out: dict[str, bool | None] = {}
+    for rid in gated:
+        path = directory / DECISIONS / f"{rid}.json"
+        try:
+            out[rid] = bool(json.loads(path.read_text())["run_finest"])
+        except (OSError, ValueError, KeyError, TypeError):
+            out[rid] = None
+    return out
 
 
 def _hours(seconds: float) -> str:
@@ -305,6 +334,8 @@ def describe(plan: Plan, *, points: bool = False) -> str:
     lines.append("by particle size: " + "; ".join(
         f"h = {h:g} um: {len(rs)} runs, {sum(r.particle_steps for r in rs):.3g} particle-steps, "
         f"{_hours(sum(r.here_s for r in rs))}" for h, rs in sorted(by_size.items(), reverse=True)))
+    if plan.gated:
+        lines.append(_refinement(plan))
     if longest is not None:
         core_h = sum(r.cluster_s for r in plan.runs.values()) * plan.cluster_threads / 3600
         requested = sum(r.request_min for r in plan.runs.values()) * plan.cluster_threads / 60
@@ -326,6 +357,23 @@ def describe(plan: Plan, *, points: bool = False) -> str:
                          f"{q['contact_radius_particles']:.1f} | {q['groove_depth_particles']:.2f} | "
                          f"{'' if t is None else f'{t:.2f}'} | {_hours(sum(plan.runs[r].here_s for r in rids))} |")
     return "\n".join(lines)
+
+
+def _refinement(plan: Plan) -> str:
+    """The range refinement only where needed leaves: every undecided gated finest run made, or none."""
+    states = list(plan.gated.values())
+    n_need, n_skip, n_open = states.count(True), states.count(False), states.count(None)
+    every = list(plan.runs)
+    high, low = plan.made(every, undecided=True), plan.made(every, undecided=False)
+    from plough.study.skipping import tolerances
+
+    tol = ", ".join(f"{o} {t:g}" for o, t in tolerances(plan.config["mpm"]["skip_finest_tolerance"]).items())
+    return (f"refinement only where needed (skip_finest_tolerance: {tol}): {len(states)} gated finest runs "
+            f"({n_need} decided needed, {n_skip} decided not, {n_open} undecided): between "
+            f"**{_hours(plan.wall_s(low))}** ({len(low)} runs, "
+            f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps; every undecided one skipped) and "
+            f"{_hours(plan.wall_s(high))} ({len(high)} runs, {sum(plan.runs[r].particle_steps for r in high):.3g} "
+            "particle-steps; every undecided one made)")
 
 
 def _sources(sources: list[str]) -> list[str]:

@@ -1,19 +1,25 @@
-"""Skipping the finest particle size where the two coarser sizes already extrapolate well enough.
+"""Refinement only where needed: the finest particle size of a sweep point runs only where the two
+coarser sizes do not already extrapolate well enough.
 
 The finest size costs about 8 x 2 = 16 times the next one (eight times the particles, twice the
-steps), so it dominates the full reproduction. With ``mpm.skip_finest_tolerance`` set, the run of
-a sweep point at the finest size first reads the point's two next-coarser runs and extrapolates
-them to h -> 0 (:func:`plough.study.extrapolation.extrapolate` with two sizes: Richardson with the
-assumed order 1 and Roache's safety factor 3). If that extrapolation's uncertainty (the GCI and the
-two runs' sampling errors carried to the limit, in quadrature) is within the
-tolerance of its value for every steady-state output in :data:`CHECKED` the finest run is not
-made: its result file is a *skip marker* (no result variables; attributes say why, with the two
-extrapolations), and the figure dataset extrapolates that point from the two coarser sizes, flagged
-``TWO_SIZES_ASSUMED_ORDER`` (``CONVERGED``, not flagged, when the two agree exactly). Pictures
-(the single-run figures) always use a real finest run. A marker where the config does not allow
-skipping that run is refused by the dataset builder.
+steps), so it dominates a reproduction. With ``mpm.skip_finest_tolerance`` set, a sweep point's two
+coarser runs are extrapolated to h -> 0 (:func:`plough.study.extrapolation.extrapolate` with two
+sizes: Richardson with the assumed order 1 and Roache's safety factor 3) by the workflow's
+checkpoint ``mpm_refine`` (docs/workflow.md, "Refinement only where needed"), which writes the
+*decision* (:func:`decide`, a JSON file ``results/refinement/<finest run id>.json``). If that
+extrapolation's uncertainty (the GCI and the two runs' sampling errors carried to the limit, in
+quadrature) is within the tolerance of its value for every steady-state output in :data:`CHECKED`
+the finest run is not needed: the figure datasets read the decision, extrapolate that point from the
+two coarser sizes, flagged ``TWO_SIZES_ASSUMED_ORDER`` (``CONVERGED``, not flagged, when the two
+agree exactly), and the finest run is never scheduled. Otherwise the datasets need the finest run
+and Snakemake makes it. Pictures (the single-run figures) always use a real finest run: their runs
+are never gated. The tolerance is one number for every checked output or one per output
+(:func:`tolerances`).
 
-Default off (``null``): the faithful reproduction runs every size.
+Default off (``null``): every size runs (the paper's ladder, ``config/paper.yaml``).
+
+*Skip markers*, the result files an earlier workflow wrote in place of a skipped finest run
+(:data:`SKIPPED_ATTR`), are no longer written; :func:`is_skipped` lets the dataset builder refuse one.
 
 **Failure markers.** A finest sweep run may also stop unstable (``plough.mpm.solver.InstabilityError``:
 at h = 2.5 um a prow can grow until material leaves the grid, docs/journal/2026-11-22-prow-at-h2.5.md). With
@@ -31,6 +37,7 @@ the zinc-coated steel one at 22 N of Figs. 14, 16-19 and 21-23, the zinc block a
 from __future__ import annotations
 
 import json
+from collections.abc import Mapping
 from typing import Any
 
 import numpy as np
@@ -42,6 +49,7 @@ from plough.study.extrapolation import extrapolate, sampling_error
 
 #: Outputs whose two-size extrapolation must be within the tolerance to skip the finest run.
 CHECKED = ("mu", "dp")
+#: the attribute of the skip markers an earlier workflow wrote (refused now: :func:`is_skipped`)
 SKIPPED_ATTR = "skipped_finest_size"
 FAILED_ATTR = "failed_finest_size"
 
@@ -79,24 +87,48 @@ def _run_error(run: xr.Dataset, output: str) -> float:
     return 0.0 if not any(n in run for n in STANDARD_ERROR_META) else float("nan")
 
 
-def should_skip(extrapolations: dict[str, dict[str, float]], tolerance: float) -> bool:
-    """True when every checked output's relative uncertainty is within ``tolerance``."""
-    if not (np.isfinite(tolerance) and tolerance > 0):
-        raise ValueError(f"mpm.skip_finest_tolerance = {tolerance!r} must be a finite number > 0")
-    return all(np.isfinite(e["relative_uncertainty"]) and e["relative_uncertainty"] <= tolerance
-               for e in extrapolations.values())
+def tolerances(tolerance: float | Mapping[str, float]) -> dict[str, float]:
+    """``mpm.skip_finest_tolerance`` as output -> relative tolerance for every output of :data:`CHECKED`:
+    one number for all, or a mapping naming each (``{mu: 0.05, dp: 0.3}``)."""
+    given = dict(tolerance) if isinstance(tolerance, Mapping) else dict.fromkeys(CHECKED, tolerance)
+    if set(given) != set(CHECKED):
+        raise ValueError(f"mpm.skip_finest_tolerance = {tolerance!r} must be a number or name each of "
+                         f"{', '.join(CHECKED)} (allowed: a finite number > 0 for each)")
+    out = {}
+    for name in CHECKED:
+        value = given[name]
+        if isinstance(value, bool) or not isinstance(value, int | float) or not (np.isfinite(value) and value > 0):
+            raise ValueError(f"mpm.skip_finest_tolerance = {tolerance!r}: {name} = {value!r} must be a finite "
+                             "number > 0")
+        out[name] = float(value)
+    return out
 
 
-def skip_marker(scene: dict[str, Any], extrapolations: dict[str, dict[str, float]], tolerance: float,
-                coarse_runs: list[str]) -> xr.Dataset:
-    """The result file of a skipped run: no result variables, the reason and provenance as attributes."""
-    return xr.Dataset(attrs={
-        SKIPPED_ATTR: 1,
-        "skip_reason": (f"the two-size extrapolation of {', '.join(coarse_runs)} is within "
-                        f"skip_finest_tolerance = {tolerance:g} for {', '.join(extrapolations)}"),
-        "skip_extrapolations": json.dumps(extrapolations),
-        **provenance_attrs(scene, key="scene"),
-    })
+def should_skip(extrapolations: dict[str, dict[str, float]], tolerance: float | Mapping[str, float]) -> bool:
+    """True when every checked output's relative uncertainty is within its tolerance (:func:`tolerances`)."""
+    tol = tolerances(tolerance)
+    return all(np.isfinite(e["relative_uncertainty"]) and e["relative_uncertainty"] <= tol[o]
+               for o, e in extrapolations.items())
+
+
+def run_size_um(run: xr.Dataset) -> float:
+    """A run file's particle size (um), from the scene it records."""
+    return float(json.loads(run.attrs["scene"])["discretisation"]["particle_size_m"]) * 1e6
+
+
+def decide(finest_run: str, coarse: xr.Dataset, mid: xr.Dataset, coarse_runs: list[str],
+           tolerance: float | Mapping[str, float]) -> dict[str, Any]:
+    """The refinement decision of a sweep point (JSON-serialisable): whether its finest run ``finest_run`` is
+    needed, from its two coarser runs (already checked against their runs), extrapolated at the particle
+    sizes their files record (the point's own ladder)."""
+    sizes = [run_size_um(coarse), run_size_um(mid)]
+    ex = two_size_extrapolation(coarse, mid, sizes[0], sizes[1])
+    skip = should_skip(ex, tolerance)
+    return {"finest_run": finest_run, "run_finest": not skip, "coarser_runs": list(coarse_runs),
+            "coarser_sizes_um": sizes, "tolerance": tolerances(tolerance), "extrapolations": ex,
+            "reason": (f"the two-size extrapolation of {', '.join(coarse_runs)} (h = {sizes[0]:g}, {sizes[1]:g} um) is "
+                       f"{'not ' if not skip else ''}within skip_finest_tolerance for {', '.join(ex)}: relative "
+                       "uncertainty " + ", ".join(f"{o} {e['relative_uncertainty']:.3g}" for o, e in ex.items()))}
 
 
 def is_skipped(ds: xr.Dataset) -> bool:
