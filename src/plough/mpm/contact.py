@@ -88,7 +88,7 @@ def _inside_box(origin, dx, shape, centre, radius):
 
 
 @njit(cache=True)
-def scatter_contact_stress(P, G, S, Z):
+def scatter_contact_stress(P, G, S, Z, ray_local=False):
     """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
     sphere onto nearby nodes.
 
@@ -101,6 +101,9 @@ def scatter_contact_stress(P, G, S, Z):
     G.cbuf[node, C_AREA:C_AREA + 3] += V grad w (the node's share of the material's surface, as a
     vector). With the mirror plane (``G.mirror_j0`` >= 0, else -1) the surface vector of a ghost node
     (y < 0) goes to its partner with its y component reversed: the mirrored particles' share.
+    With ``ray_local`` (the position-corrected variant, ``discretisation.contact: grid_local``) a particle sets a
+    node's proximity only if it lies within half a cell of the node's ray from the sphere's centre (the gap of the
+    material *at the node*, not of its whole stencil; the stress, strength and surface sums are unchanged).
     Serial: few particles are near the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
     Only particles flagged ``near`` (within ``S.near_dist`` = 3 dx of the sphere, set by g2p) are
     scattered; a node at the edge of the reach (r + dx) has stencil particles out to about r + 3.6 dx,
@@ -139,7 +142,16 @@ def scatter_contact_stress(P, G, S, Z):
                     cbuf[node, 6] += wm * kappa
                     cbuf[node, 7] += wm
                     if prox > cbuf[node, 8]:
-                        cbuf[node, 8] = prox
+                        on_ray = True
+                        if ray_local:
+                            # lateral offset of the particle from the node's ray: |q - (q . n_i) n_i|
+                            r = math.sqrt(px * px + py * py + pz * pz)
+                            if r > 0.0:
+                                along = (q0 * px + q1 * py + q2 * pz) / r
+                                lat2 = q0 * q0 + q1 * q1 + q2 * q2 - along * along
+                                on_ray = lat2 <= 0.25 * dx * dx
+                        if on_ray:
+                            cbuf[node, 8] = prox
                     s1 = v_dx * st.wx[a] * dwy[b] * st.wz[cc]
                     j = st.base[1] + b
                     if mirror_j0 >= 0 and j < mirror_j0:

@@ -292,7 +292,7 @@ ACTIVE_ZONE_MIN_PARTICLES = 20.0
 DILATATION_MODES = ("projected", "local")
 FINE_ZONE_SHAPES = ("square", "disc")
 #: where the sphere acts on the material (see Discretisation and plough.mpm.contact)
-CONTACT_MODES = ("grid", "particle")
+CONTACT_MODES = ("grid", "particle", "grid_local")
 
 
 @dataclass(frozen=True)
@@ -332,7 +332,9 @@ class Discretisation:
     None (default) updates every particle (docs/journal/2026-11-23-active-zone.md).
 
     ``contact``: "grid" (default) imposes the sphere on the grid nodes within a cell of it, each limited by
-    the gap of its closest stencil particle (:func:`plough.mpm.contact.sphere_contact`); "particle" imposes
+    the gap of its closest stencil particle (:func:`plough.mpm.contact.sphere_contact`); "grid_local" the same
+    with the gap of the closest particle on the node's own ray (a diagnostic: how much of the grid contact's
+    error is where it detects contact); "particle" imposes
     it on each near particle whose face would cross the sphere's exact surface in the step, through the
     particle's own nodes (:func:`plough.mpm.contact.particle_contact`; docs/journal/2026-12-02-contact-candidates.md).
     """

@@ -120,7 +120,7 @@ class Constants:
     contact_hold_steps: float  # a node stays in contact this many steps after its last normal push
     flip: float  # FLIP share of the particle velocity update (0 = APIC)
     project_dilatation: int  # 1: J and pressure from the grid-projected dilatation rate
-    particle_contact: int  # 1: the sphere acts on the particles (contact.particle_contact), 0: on the grid nodes
+    contact_mode: str  # discretisation.contact: grid, grid_local (nodes) or particle (contact.particle_contact)
     filter_alpha: float
     control: str
     target_depth: float | None
@@ -305,7 +305,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
         flip=disc.flip, project_dilatation=int(disc.dilatation == "projected"),
-        particle_contact=int(disc.contact == "particle"),
+        contact_mode=disc.contact,
         contact_hold_steps=contact.HOLD_WAVE_TIMES * dx / (c * dt),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
@@ -359,10 +359,10 @@ def step(s: State, c: Constants) -> None:
     P, G, S, Z, w = s.particles, grid_data(s, c), sphere_data(s, c), s.zone.ranges(), s.work
     transfers.p2g(P, G, c.dt, Z)  # 1. P2G
     transfers.grid_update(G, Z)  # 2. grid velocities, boundary conditions
-    if c.particle_contact:  # 3. contact: the sphere on the near particles, through their nodes
+    if c.contact_mode == "particle":  # 3. contact: the sphere on the near particles, through their nodes
         contact.particle_contact(P, G, S, Z, c.contact_law, s.step, c.dt, w.last_push_p, w.contact_out)
     else:  # or: the near particles' stress on the nodes, then the sphere on the nodes
-        contact.scatter_contact_stress(P, G, S, Z)
+        contact.scatter_contact_stress(P, G, S, Z, c.contact_mode == "grid_local")
         contact.sphere_contact(G, S, c.contact_law, s.step, c.dt, w.contact_out)
     if G.mirror_j0 >= 0:
         transfers.mirror_ghosts(G, Z)
