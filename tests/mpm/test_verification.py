@@ -14,7 +14,7 @@ import pytest
 
 from plough.materials import ProportionalShear
 from plough.mpm import solver
-from plough.mpm.indentation import E_PA, NU, R_M, hertz_scene, hold_at_depth
+from plough.mpm.indentation import E_PA, NU, R_M, hertz_force, hertz_scene, hold_at_depth
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 
@@ -42,6 +42,18 @@ def test_hertz_indentation_error_shrinks_with_h():
     err = {h: indentation_force(h, depth * 1e6) / hertz - 1.0 for h in (10.0, 5.0)}
     assert err[10.0] > err[5.0] > 0.0
     assert err[5.0] < 0.5 * err[10.0]
+
+
+def test_particle_contact_meets_the_hertz_target_at_h10():
+    """The particle contact (discretisation.contact: particle) acts where the sphere is: at h = 10 um the Hertz
+    force is +14.7% at 2 um and +23.9% at 8 um (the grid contact: +89% / +42%), within the issue's 25%
+    (benchmarks/contact_candidates.py hertz; docs/journal/2026-12-02-contact-candidates.md). No particle centre
+    enters the sphere."""
+    for depth_um, bound in ((2.0, 0.20), (8.0, 0.25)):
+        run = hold_at_depth(hertz_scene(10.0, depth_um, contact_mode="particle"))
+        err = run.force_N / hertz_force(depth_um * 1e-6) - 1.0
+        assert 0.0 < err < bound, (depth_um, err)
+        assert run.closest_centre_m > 0.0
 
 
 def test_projected_dilatation_removes_volumetric_locking_in_hertz_contact():
