@@ -528,3 +528,24 @@ def test_contact_consumes_every_folded_surface_vector(centre_y):
     run_contact(np.ones(N_NODES), np.zeros((N_NODES, 3)), cbuf, flags, no_memory(), centre, radius,
                 np.array([0.1, 0.0, 0.0]), ct.INTERFACE_PROPORTIONAL, [1.0, 0.0])
     np.testing.assert_array_equal(cbuf, 0.0)
+
+
+def test_ray_local_proximity_is_the_stencils_for_the_particles_on_the_nodes_ray():
+    """grid_local (``ray_local``): a node's proximity comes from the particles within half a cell of its ray from
+    the sphere's centre, so it never exceeds the whole stencil's, is the stencil's where the closest particle lies
+    on the ray, and the stress, strength, mass and surface channels are the same."""
+    h = 0.5
+    radius = 3.3 * DX
+    centre = np.array([ORIGIN[0] + 5.2 * DX, ORIGIN[1] + 4.9 * DX, ORIGIN[2] + (10.0 - 0.3) * DX + radius])
+    x = _lattice([2, 2, 2], [9, 9, 10], h)
+    n = x.shape[0]
+    G = {}
+    for local in (False, True):
+        G[local] = grid_of(ORIGIN, DX, SHAPE)
+        P = particles_of(n, x=x, vol0=np.full(n, (h * DX) ** 3), near=np.ones(n, dtype=np.int8))
+        ct.scatter_contact_stress(P, G[local], SphereData(centre, np.zeros(3), radius, 3 * DX), whole(n, SHAPE), local)
+    full, local = G[False].cbuf, G[True].cbuf
+    others = [k for k in range(ct.N_CBUF) if k != 8]
+    np.testing.assert_array_equal(local[:, others], full[:, others])
+    assert np.all(local[:, 8] <= full[:, 8])
+    assert np.any(local[:, 8] < full[:, 8]) and np.any((local[:, 8] == full[:, 8]) & (full[:, 8] > 0))

@@ -48,9 +48,10 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
 from numba import njit
 
-from plough.mpm.grid import GHOST, MIRROR
+from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import bspline2_grad, stencil, stencil_node
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
@@ -87,7 +88,7 @@ def _inside_box(origin, dx, shape, centre, radius):
 
 
 @njit(cache=True)
-def scatter_contact_stress(P, G, S, Z):
+def scatter_contact_stress(P, G, S, Z, ray_local=False):
     """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
     sphere onto nearby nodes.
 
@@ -100,6 +101,9 @@ def scatter_contact_stress(P, G, S, Z):
     G.cbuf[node, C_AREA:C_AREA + 3] += V grad w (the node's share of the material's surface, as a
     vector). With the mirror plane (``G.mirror_j0`` >= 0, else -1) the surface vector of a ghost node
     (y < 0) goes to its partner with its y component reversed: the mirrored particles' share.
+    With ``ray_local`` (the position-corrected variant, ``discretisation.contact: grid_local``) a particle sets a
+    node's proximity only if it lies within half a cell of the node's ray from the sphere's centre (the gap of the
+    material *at the node*, not of its whole stencil; the stress, strength and surface sums are unchanged).
     Serial: few particles are near the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
     Only particles flagged ``near`` (within ``S.near_dist`` = 3 dx of the sphere, set by g2p) are
     scattered; a node at the edge of the reach (r + dx) has stencil particles out to about r + 3.6 dx,
@@ -138,7 +142,16 @@ def scatter_contact_stress(P, G, S, Z):
                     cbuf[node, 6] += wm * kappa
                     cbuf[node, 7] += wm
                     if prox > cbuf[node, 8]:
-                        cbuf[node, 8] = prox
+                        on_ray = True
+                        if ray_local:
+                            # lateral offset of the particle from the node's ray: |q - (q . n_i) n_i|
+                            r = math.sqrt(px * px + py * py + pz * pz)
+                            if r > 0.0:
+                                along = (q0 * px + q1 * py + q2 * pz) / r
+                                lat2 = q0 * q0 + q1 * q1 + q2 * q2 - along * along
+                                on_ray = lat2 <= 0.25 * dx * dx
+                        if on_ray:
+                            cbuf[node, 8] = prox
                     s1 = v_dx * st.wx[a] * dwy[b] * st.wz[cc]
                     j = st.base[1] + b
                     if mirror_j0 >= 0 and j < mirror_j0:
@@ -289,3 +302,203 @@ def sphere_contact(G, S, law, step, dt, out):
                 out[OUT_NODES] += 1.0
                 if n2 < 0.0:
                     out[OUT_AREA_XY] += area * (-n2)
+
+
+# ----------------------------------------------------------------------------- contact on the particles
+@njit(cache=True, inline="always")
+def _fold(t, j, mirror_j0, ny, nz):
+    """The node that holds node t's velocity (t itself, or across the mirror plane for a ghost at j < mirror_j0)
+    and the sign of its y component there (-1 if the partner lies off the grid)."""
+    if mirror_j0 >= 0 and j < mirror_j0:
+        if 2 * mirror_j0 - j >= ny:
+            return -1, 1.0
+        return t + (2 * (mirror_j0 - j)) * nz, -1.0
+    return t, 1.0
+
+
+@njit(cache=True)
+def _apply_impulse(G, S, nodes, ysign, wts, k, jx, jy, jz, acc):
+    """Scatter the impulse (jx, jy, jz) of near particle k to its nodes by its B-spline weights: node t gets
+    w J / m_t (y reversed on a ghost's partner, none along y on the mirror plane). Adds to acc[0:3] the
+    momentum given, acc[3] the work the sphere did (momentum . sphere velocity), acc[4] the kinetic energy
+    the nodes gained."""
+    grid_m, grid_v, flags, vs = G.m, G.v, G.flags, S.velocity
+    for s in range(27):
+        t = nodes[k, s]
+        if t < 0:
+            continue
+        m = grid_m[t]
+        w = wts[k, s] / m
+        d0 = w * jx
+        d1 = 0.0 if flags[t] == MIRROR else w * jy * ysign[k, s]
+        d2 = w * jz
+        v0, v1, v2 = grid_v[t, 0], grid_v[t, 1], grid_v[t, 2]
+        acc[0] += m * d0
+        acc[1] += m * d1
+        acc[2] += m * d2
+        acc[3] += m * (d0 * vs[0] + d1 * vs[1] + d2 * vs[2])
+        acc[4] += m * (v0 * d0 + v1 * d1 + v2 * d2 + 0.5 * (d0 * d0 + d1 * d1 + d2 * d2))
+        grid_v[t, 0] = v0 + d0
+        grid_v[t, 1] = v1 + d1
+        grid_v[t, 2] = v2 + d2
+
+
+@njit(cache=True, inline="always")
+def _particle_velocity(G, nodes, ysign, wts, k):
+    """sum_i w_i v_i over near particle k's nodes: the velocity it will be advected with (a node the step holds
+    still, or without mass, counts with velocity 0, as g2p reads it)."""
+    grid_v = G.v
+    u0 = 0.0
+    u1 = 0.0
+    u2 = 0.0
+    for s in range(27):
+        t = nodes[k, s]
+        if t < 0:
+            continue
+        w = wts[k, s]
+        u0 += w * grid_v[t, 0]
+        u1 += w * grid_v[t, 1] * ysign[k, s]
+        u2 += w * grid_v[t, 2]
+    return u0, u1, u2
+
+
+@njit(cache=True)
+def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
+    """Impose the exact sphere on the near particles, through their own nodes, and measure the reaction.
+
+    A particle p near the sphere has the face gap g_p = |x_p - c| - R - e_p / 2 (e_p = V_p^(1/3), the
+    particle's size; n_p the sphere's outward normal at it) and is advected in this step with
+    u_p = sum_i w_ip v_i. Its face must not cross the sphere by the end of the step, to first order in dt:
+    (u_p - v_sphere) . n_p >= -max(g_p, 0) / dt (a particle found inside stops approaching; it is not thrown
+    out, which would put energy in, as the grid contact's gap rule does). A faster approach is cut by a
+    normal impulse lambda_p n_p scattered to its nodes like a body force (node i gets w_ip lambda_p n_p / m_i),
+    which changes u_p by lambda_p n_p / m_eff,p, m_eff,p = 1 / sum_i (w_ip^2 / m_i). Touching particles share
+    nodes, so the impulses are found by projected Gauss-Seidel over them (``law.sweeps`` sweeps, lambda_p >= 0
+    accumulated; a later sweep may lower one). Only particles whose face meets the sphere act, so the
+    footprint is the sphere's to within a particle, not a cell wider (``sphere_contact``).
+
+    Interface shear: a particle pushed at ``step``, or within ``law.hold_steps`` steps (its
+    ``last_push_p``), gets a tangential impulse against its slip, J_t <= min(tau A_p dt, m_eff |u_t|)
+    (it never reverses the slip), with A_p = e_p^2 / (|n_x| + |n_y| + |n_z|), the area per particle of a
+    cubic lattice's face cut by a plane of normal n, tau from ``interface_shear`` with kappa = sigma_y0 / sqrt 3
+    and the pressure -n . sigma . n of the particle itself; one Gauss-Seidel pass after the normal ones.
+
+    Reads P.x, vol0, J, stress, sigma_y0, near of the active particles Z.p_lo <= p < Z.p_hi; G.m, G.flags, the
+    grid geometry and the zone's free x range (Z.i_free_lo..i_free_hi: nodes beyond it, FIXED nodes and
+    nodes without mass take no impulse); the sphere S; the law. Writes G.v of the particles' nodes,
+    last_push_p[p] and out[0:N_OUT]: the forces on the sphere are minus the momentum given to the nodes
+    (/ dt), OUT_WORK the sphere's work (that momentum . v_sphere), OUT_IMPACT and OUT_DISSIPATION the work of
+    the normal and tangential impulses less the nodes' kinetic energy gain (so the contact's energy account
+    closes exactly), OUT_NODES the number of particles pushed, OUT_AREA_XY their sum A_p |n_z| (n_z < 0).
+    Mirror plane (G.mirror_j0 >= 0): a stencil node at y < 0 is the ghost of its partner at -y, whose
+    velocity it reads and whose velocity takes the impulse with y reversed; a node on the plane keeps v_y = 0
+    (it holds the half body's mass and takes the half body's impulse). Serial: few particles are near the
+    sphere, and Gauss-Seidel needs each impulse applied before the next particle reads its velocity.
+    """
+    x, near = P.x, P.near
+    origin, dx, centre, radius, vs = G.origin, G.dx, S.centre, S.radius, S.velocity
+    grid_m, flags, mirror_j0 = G.m, G.flags, G.mirror_j0
+    ny, nz = G.shape[1], G.shape[2]
+    inv_dx = 1.0 / dx
+    for k in range(N_OUT):
+        out[k] = 0.0
+    # the candidates: near particles whose face lies within a cell of the sphere (a farther one would need
+    # to approach faster than a cell per step)
+    count = 0
+    for p in range(Z.p_lo, Z.p_hi):
+        if near[p] != 0:
+            count += 1
+    idx = np.empty(count, dtype=np.int64)
+    gap = np.empty(count)
+    nrm = np.empty((count, 3))
+    size = np.empty(count)
+    nk = 0
+    for p in range(Z.p_lo, Z.p_hi):
+        if near[p] == 0:
+            continue
+        q0 = x[p, 0] - centre[0]
+        q1 = x[p, 1] - centre[1]
+        q2 = x[p, 2] - centre[2]
+        dist = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
+        e = (P.vol0[p] * P.J[p]) ** (1.0 / 3.0)
+        g = dist - radius - 0.5 * e
+        if g >= dx or dist <= 0.0:
+            continue
+        idx[nk] = p
+        gap[nk] = g
+        nrm[nk, 0] = q0 / dist
+        nrm[nk, 1] = q1 / dist
+        nrm[nk, 2] = q2 / dist
+        size[nk] = e
+        nk += 1
+    nodes = np.full((nk, 27), -1, dtype=np.int64)
+    ysign = np.ones((nk, 27))
+    wts = np.zeros((nk, 27))
+    inv_meff = np.zeros(nk)
+    for k in range(nk):
+        st = stencil(x, idx[k], origin, inv_dx)
+        s = 0
+        for a in range(3):
+            i = st.base[0] + a
+            for b in range(3):
+                j = st.base[1] + b
+                for cc in range(3):
+                    node, w = stencil_node(st, a, b, cc, ny, nz)
+                    t, sign = _fold(node, j, mirror_j0, ny, nz)
+                    if (0 <= t < grid_m.size and grid_m[t] > 0.0 and flags[t] != FIXED
+                            and Z.i_free_lo <= i <= Z.i_free_hi):
+                        nodes[k, s] = t
+                        ysign[k, s] = sign
+                        wts[k, s] = w
+                        inv_meff[k] += w * w / grid_m[t]
+                    s += 1
+    lam = np.zeros(nk)
+    acc_n = np.zeros(5)
+    for _sweep in range(law.sweeps):
+        for k in range(nk):
+            if inv_meff[k] <= 0.0:
+                continue
+            u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
+            vn = (u0 - vs[0]) * nrm[k, 0] + (u1 - vs[1]) * nrm[k, 1] + (u2 - vs[2]) * nrm[k, 2]
+            new = max(lam[k] + (-max(gap[k], 0.0) / dt - vn) / inv_meff[k], 0.0)
+            d = new - lam[k]
+            if d != 0.0:
+                lam[k] = new
+                _apply_impulse(G, S, nodes, ysign, wts, k, d * nrm[k, 0], d * nrm[k, 1], d * nrm[k, 2], acc_n)
+    acc_t = np.zeros(5)
+    pushed = 0
+    area_xy = 0.0
+    for k in range(nk):
+        p = idx[k]
+        n0, n1, n2 = nrm[k, 0], nrm[k, 1], nrm[k, 2]
+        area = size[k] * size[k] / (abs(n0) + abs(n1) + abs(n2))
+        if lam[k] > 0.0:
+            last_push_p[p] = step
+            pushed += 1
+            if n2 < 0.0:
+                area_xy += area * (-n2)
+        elif step - last_push_p[p] > law.hold_steps or inv_meff[k] <= 0.0:
+            continue
+        sg = P.stress[p]
+        pressure = -(n0 * n0 * sg[0] + n1 * n1 * sg[1] + n2 * n2 * sg[2]
+                     + 2.0 * (n1 * n2 * sg[3] + n0 * n2 * sg[4] + n0 * n1 * sg[5]))
+        tau = interface_shear(law.model, law.params, pressure, P.sigma_y0[p] / SQRT3)
+        if tau <= 0.0:
+            continue
+        u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
+        r0, r1, r2 = u0 - vs[0], u1 - vs[1], u2 - vs[2]
+        vn = r0 * n0 + r1 * n1 + r2 * n2
+        t0, t1, t2 = r0 - vn * n0, r1 - vn * n1, r2 - vn * n2
+        vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
+        if vt <= 0.0:
+            continue
+        jt = min(vt / inv_meff[k], tau * area * dt)
+        _apply_impulse(G, S, nodes, ysign, wts, k, -jt * t0 / vt, -jt * t1 / vt, -jt * t2 / vt, acc_t)
+    for d in range(3):
+        out[OUT_FN + d] = -acc_n[d] / dt
+        out[OUT_FT + d] = -acc_t[d] / dt
+    out[OUT_WORK] = acc_n[3] + acc_t[3]
+    out[OUT_IMPACT] = acc_n[3] - acc_n[4]
+    out[OUT_DISSIPATION] = acc_t[3] - acc_t[4]
+    out[OUT_NODES] = pushed
+    out[OUT_AREA_XY] = area_xy

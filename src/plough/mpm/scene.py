@@ -294,6 +294,8 @@ FINE_ZONE_SHAPES = ("square", "disc")
 #: smallest fine-zone depth below the expected groove or the coating, in particle sizes h: the groove's
 #: bottom and the coating-substrate interface each keep at least two layers of h particles below them
 FINE_ZONE_MIN_DEPTH_PARTICLES = 2.0
+#: where the sphere acts on the material (see Discretisation and plough.mpm.contact)
+CONTACT_MODES = ("grid", "particle", "grid_local")
 
 
 @dataclass(frozen=True)
@@ -336,6 +338,13 @@ class Discretisation:
     The zone moves with the sphere and a particle that leaves it behind stays frozen; until
     particles lie frozen beyond an end of the zone, the block's own end face there stays free.
     None (default) updates every particle (docs/journal/2026-11-23-active-zone.md).
+
+    ``contact``: "grid" (default) imposes the sphere on the grid nodes within a cell of it, each limited by
+    the gap of its closest stencil particle (:func:`plough.mpm.contact.sphere_contact`); "grid_local" the same
+    with the gap of the closest particle on the node's own ray (a diagnostic: how much of the grid contact's
+    error is where it detects contact); "particle" imposes
+    it on each near particle whose face would cross the sphere's exact surface in the step, through the
+    particle's own nodes (:func:`plough.mpm.contact.particle_contact`; docs/journal/2026-12-02-contact-candidates.md).
     """
 
     particle_size_m: float = 10e-6
@@ -349,6 +358,7 @@ class Discretisation:
     fine_zone_shape: str = "square"
     fine_zone_depth_particles: float | None = None
     active_zone_contact_radii: float | None = None
+    contact: str = "grid"
 
     def __post_init__(self) -> None:
         _finite_positive("discretisation", "particle_size_m", self.particle_size_m, "m")
@@ -385,6 +395,8 @@ class Discretisation:
             raise ValueError(f"discretisation.active_zone_contact_radii = {k!r} is outside the allowed range "
                              f"[{ACTIVE_ZONE_MIN_CONTACT_RADII:g}, inf) or null: the plastic zone (about 2 expected "
                              "contact radii) must lie in the active zone")
+        if self.contact not in CONTACT_MODES:
+            raise ValueError(f"discretisation.contact = {self.contact!r} is not one of {list(CONTACT_MODES)}")
         if self.graded and self.particles_per_cell < 2:
             raise ValueError("discretisation.graded = true needs discretisation.particles_per_cell >= 2 (got "
                              f"{self.particles_per_cell}): the far-field particles of size 2 h must not exceed a cell")

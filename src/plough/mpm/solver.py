@@ -120,6 +120,7 @@ class Constants:
     contact_hold_steps: float  # a node stays in contact this many steps after its last normal push
     flip: float  # FLIP share of the particle velocity update (0 = APIC)
     project_dilatation: int  # 1: J and pressure from the grid-projected dilatation rate
+    contact_mode: str  # discretisation.contact: grid, grid_local (nodes) or particle (contact.particle_contact)
     filter_alpha: float
     control: str
     target_depth: float | None
@@ -199,6 +200,7 @@ class Work:
     flags: np.ndarray
     cbuf: np.ndarray
     last_push: np.ndarray  # per-node step of the last normal push of the contact
+    last_push_p: np.ndarray  # per-particle step of the last normal push (particle contact)
     acc: np.ndarray
     contact_out: np.ndarray
     grid_div: np.ndarray  # projected nodal dilatation rate, 1/s
@@ -303,6 +305,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         slide_speed=scene.sliding.speed_m_s, slide_distance=scene.sliding.distance_m,
         control_gain=1.0 / (k_est * CONTROL_STEPS * dt), filter_alpha=1.0 / FILTER_STEPS,
         flip=disc.flip, project_dilatation=int(disc.dilatation == "projected"),
+        contact_mode=disc.contact,
         contact_hold_steps=contact.HOLD_WAVE_TIMES * dx / (c * dt),
         control=scene.sliding.control, target_depth=scene.sliding.depth_m, sphere_radius=r,
         steps_slide=int(math.ceil(scene.sliding.distance_m / (scene.sliding.speed_m_s * dt))),
@@ -320,6 +323,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         grid_v=np.zeros((grid.n_nodes, 6)),
         flags=boundary_flags(grid, scene.domain.radius_m, scene.domain.symmetric),
         cbuf=np.zeros((grid.n_nodes, contact.N_CBUF)), last_push=np.full(grid.n_nodes, contact.NEVER_PUSHED),
+        last_push_p=np.full(particles.n, contact.NEVER_PUSHED),
         acc=np.zeros((n_chunks, transfers.N_ACC)),
         contact_out=np.zeros(contact.N_OUT), grid_div=np.zeros(grid.n_nodes),
         L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
@@ -355,8 +359,11 @@ def step(s: State, c: Constants) -> None:
     P, G, S, Z, w = s.particles, grid_data(s, c), sphere_data(s, c), s.zone.ranges(), s.work
     transfers.p2g(P, G, c.dt, Z)  # 1. P2G
     transfers.grid_update(G, Z)  # 2. grid velocities, boundary conditions
-    contact.scatter_contact_stress(P, G, S, Z)  # 3. contact: the near particles' stress on the nodes,
-    contact.sphere_contact(G, S, c.contact_law, s.step, c.dt, w.contact_out)  # the sphere on the nodes
+    if c.contact_mode == "particle":  # 3. contact: the sphere on the near particles, through their nodes
+        contact.particle_contact(P, G, S, Z, c.contact_law, s.step, c.dt, w.last_push_p, w.contact_out)
+    else:  # or: the near particles' stress on the nodes, then the sphere on the nodes
+        contact.scatter_contact_stress(P, G, S, Z, c.contact_mode == "grid_local")
+        contact.sphere_contact(G, S, c.contact_law, s.step, c.dt, w.contact_out)
     if G.mirror_j0 >= 0:
         transfers.mirror_ghosts(G, Z)
     move_sphere(s.sphere, c)  # 4. sphere motion

@@ -1,0 +1,126 @@
+"""Static indentation: the sphere pressed to a depth and held there (no sliding), for the verification tests
+and the contact benchmark (docs/verification.md: Hertz, Tabor).
+
+- :func:`hertz_scene`: an elastic block that never yields, so the force has Hertz's closed form
+  F = 4/3 E* sqrt(R) d^1.5 (:func:`hertz_force`);
+- :func:`tabor_scene`: the uncoated rigid-plastic material (H = 900 MPa, sigma_y = H / 3, E = 210 GPa), fully
+  plastic at a few um depth, whose mean pressure over the true contact is about 2.8-3 sigma_y (Tabor);
+- :func:`hold_at_depth`: press to the depth, settle (``solver.SETTLE_STEPS``), and average the full-body force
+  over the last ``average_steps`` steps;
+- :func:`contact_radius_from_particles`: the radius where the material's surface (the particles' faces, pile-up
+  included) leaves the sphere, from rings of one particle size around the sphere's axis.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from plough.materials import rigid_plastic
+from plough.mpm import contact, solver
+from plough.mpm.scene import Scene
+
+R_M, E_PA, NU = 200e-6, 210e9, 0.3
+#: the rigid-plastic hardness of the Tabor scene, Pa (the uncoated reference scene's)
+TABOR_HARDNESS_PA = 900e6
+
+
+def hertz_force(depth_m: float, radius_m: float = R_M, youngs_Pa: float = E_PA, poisson_ratio: float = NU) -> float:
+    """Hertz's force on a rigid sphere pressed ``depth_m`` into an elastic half-space, N."""
+    return 4.0 / 3.0 * youngs_Pa / (1.0 - poisson_ratio**2) * math.sqrt(radius_m) * depth_m**1.5
+
+
+def _indentation_scene(name: str, substrate, h_um: float, depth_um: float, domain_um: float, dilatation: str,
+                       contact_mode: str, particles_per_cell: int) -> Scene:
+    return Scene.from_dict({
+        "name": name, "load_N": 1.0, "sphere": {"radius_um": R_M * 1e6},
+        "layers": {"substrate": substrate},
+        "interface": {"model": "proportional", "f": 0.0},
+        "domain": {"radius_um": domain_um, "length_um": 2 * domain_um, "symmetric": True},
+        "sliding": {"distance_um": 100, "control": "displacement", "depth_um": depth_um},
+        "discretisation": {"particle_size_um": h_um, "particles_per_cell": particles_per_cell, "cfl": 0.3,
+                           "mass_scaling": 1e6, "dilatation": dilatation, "contact": contact_mode},
+    })
+
+
+def hertz_scene(h_um: float, depth_um: float, domain_um: float = 240.0, poisson_ratio: float = NU,
+                dilatation: str = "projected", contact_mode: str = "grid", particles_per_cell: int = 2) -> Scene:
+    """The sphere (R = 200 um) held ``depth_um`` deep in an elastic block that never yields (half block of radius
+    ``domain_um``, twice as long, mirror plane; frictionless)."""
+    substrate = replace(rigid_plastic("elastic", 1e15, coating=False), poisson_ratio=poisson_ratio)  # never yields
+    return _indentation_scene("hertz", substrate, h_um, depth_um, domain_um, dilatation, contact_mode,
+                              particles_per_cell)
+
+
+def tabor_scene(h_um: float, depth_um: float, domain_um: float = 240.0, contact_mode: str = "grid",
+                particles_per_cell: int = 2) -> Scene:
+    """The sphere held ``depth_um`` deep in the rigid-plastic block of the uncoated reference scene (H = 900 MPa,
+    sigma_y = 300 MPa, E = 210 GPa; frictionless)."""
+    substrate = rigid_plastic("tabor", TABOR_HARDNESS_PA, coating=False)
+    return _indentation_scene("tabor", substrate, h_um, depth_um, domain_um, "projected", contact_mode,
+                              particles_per_cell)
+
+
+@dataclass
+class Indentation:
+    """What :func:`hold_at_depth` measured."""
+
+    force_N: float  # full-body normal force, mean over the last average_steps steps
+    force_std_N: float  # its standard deviation over those steps
+    steps: int
+    wall_s: float
+    closest_centre_m: float  # over the run, the closest a particle centre came to the sphere's surface (< 0: inside)
+    contact_area_xy_m2: float  # the contact's own projected area (nodes or particles), full body, mean like the force
+    state: solver.State
+    const: solver.Constants
+
+
+def hold_at_depth(scene: Scene, average_steps: int = 100) -> Indentation:
+    """Press the sphere to the scene's depth at the middle of the block, settle, and measure the force."""
+    state, const = solver.init(scene)
+    state.sphere.centre[0] = 0.5 * scene.domain.length_m
+    fz, area = [], []
+    closest = math.inf
+    t0 = time.perf_counter()
+    while state.sphere.phase != "slide":  # press to the depth, then settle (SETTLE_STEPS)
+        solver.step(state, const)
+        out = state.work.contact_out
+        fz.append(const.symmetry_factor * (out[contact.OUT_FN + 2] + out[contact.OUT_FT + 2]))
+        area.append(const.symmetry_factor * out[contact.OUT_AREA_XY])
+        # ACC_PENETRATION: the deepest a particle centre lies inside the sphere (negative: the closest outside)
+        closest = min(closest, -float(state.work.acc[:, solver.transfers.ACC_PENETRATION].max()))
+    return Indentation(force_N=float(np.mean(fz[-average_steps:])), force_std_N=float(np.std(fz[-average_steps:])),
+                       steps=state.step, wall_s=time.perf_counter() - t0, closest_centre_m=closest,
+                       contact_area_xy_m2=float(np.mean(area[-average_steps:])), state=state, const=const)
+
+
+def contact_radius_from_particles(state: solver.State, const: solver.Constants, tolerance: float = 0.25) -> float:
+    """Radius of the true contact, m: where the material's surface leaves the sphere, pile-up included.
+
+    Rings of one particle size h around the sphere's axis; in each, the smallest face gap of its particles
+    (centre distance to the sphere's centre less R less half the particle's size). The contact ends where
+    that gap first exceeds ``tolerance`` h, outward from the axis; the radius is interpolated linearly between
+    the last ring in contact and the first out (ring midpoints). The same measure for every contact."""
+    x, c = state.particles.x, state.sphere.centre
+    size = (state.particles.vol0 * state.particles.J) ** (1.0 / 3.0)
+    h = float(np.min(size))
+    r = np.hypot(x[:, 0] - c[0], x[:, 1] - c[1])
+    gap = np.linalg.norm(x - c, axis=1) - const.sphere_radius - 0.5 * size
+    below = x[:, 2] < c[2]
+    tol = tolerance * h
+    ring = np.floor(r / h).astype(np.int64)
+    n_rings = int(const.sphere_radius / h)
+    g_min = np.full(n_rings, np.inf)
+    sel = below & (ring < n_rings)
+    np.minimum.at(g_min, ring[sel], gap[sel])
+    mid = (np.arange(n_rings) + 0.5) * h
+    for k in range(n_rings):
+        if g_min[k] > tol:
+            if k == 0:
+                return 0.0
+            g0, g1 = g_min[k - 1], min(g_min[k], 4.0 * h)
+            return float(mid[k - 1] + (tol - g0) / (g1 - g0) * h)
+    return float(mid[-1])
