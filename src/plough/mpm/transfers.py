@@ -53,7 +53,7 @@ from numba import njit, prange
 
 from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
 from plough.mpm.grid import FIXED, GHOST, MIRROR
-from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_node, stencil_offset, stencil_row
+from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row
 
 # per-chunk accumulators written by g2p_update
 ACC_PLASTIC_WORK = 0
@@ -86,7 +86,8 @@ def p2g(P, G, dt, Z):
     n = p_hi - p_lo
     n_chunks = G.buf.shape[0]
     ny, nz = G.shape[1], G.shape[2]
-    inv_dx = 1.0 / G.dx
+    dx = G.dx
+    inv_dx = 1.0 / dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
         buf = G.buf[c]
@@ -94,31 +95,48 @@ def p2g(P, G, dt, Z):
         for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             m = mass[p]
             k_stress = -dt * vol0[p] * J[p] * dinv
-            s = stress[p]
+            # the stress in locals: the grid stores below may alias the stress array as far as the compiler
+            # knows, and would make it reload them at every node
+            s0, s1, s2, s3, s4, s5 = stress[p, 0], stress[p, 1], stress[p, 2], stress[p, 3], stress[p, 4], stress[p, 5]
             # affine momentum matrix Q = m C - dt V D^-1 sigma
-            q00 = m * C[p, 0, 0] + k_stress * s[0]
-            q11 = m * C[p, 1, 1] + k_stress * s[1]
-            q22 = m * C[p, 2, 2] + k_stress * s[2]
-            q12 = m * C[p, 1, 2] + k_stress * s[3]
-            q21 = m * C[p, 2, 1] + k_stress * s[3]
-            q02 = m * C[p, 0, 2] + k_stress * s[4]
-            q20 = m * C[p, 2, 0] + k_stress * s[4]
-            q01 = m * C[p, 0, 1] + k_stress * s[5]
-            q10 = m * C[p, 1, 0] + k_stress * s[5]
+            q00 = m * C[p, 0, 0] + k_stress * s0
+            q11 = m * C[p, 1, 1] + k_stress * s1
+            q22 = m * C[p, 2, 2] + k_stress * s2
+            q12 = m * C[p, 1, 2] + k_stress * s3
+            q21 = m * C[p, 2, 1] + k_stress * s3
+            q02 = m * C[p, 0, 2] + k_stress * s4
+            q20 = m * C[p, 2, 0] + k_stress * s4
+            q01 = m * C[p, 0, 1] + k_stress * s5
+            q10 = m * C[p, 1, 0] + k_stress * s5
             mv0, mv1, mv2 = m * v[p, 0], m * v[p, 1], m * v[p, 2]
             st = stencil(x, p, G.origin, inv_dx)
+            # the x and y parts of each sum are taken once per (a, b) row of three nodes, in the order the sums
+            # are written in (w = (wx wy) wz, (mv + q d0 + q d1) + q d2): the same round-off as per node
             for a in range(3):
+                wa = st.wx[a]
+                d0 = stencil_axis_offset(st, 0, a, dx)
                 for b in range(3):
+                    wab = wa * st.wy[b]
+                    d1 = stencil_axis_offset(st, 1, b, dx)
+                    row = stencil_row(st, a, b, ny, nz)
+                    r1 = mv0 + q00 * d0 + q01 * d1
+                    r2 = mv1 + q10 * d0 + q11 * d1
+                    r3 = mv2 + q20 * d0 + q21 * d1
+                    f1 = s0 * d0 + s5 * d1
+                    f2 = s5 * d0 + s1 * d1
+                    f3 = s4 * d0 + s3 * d1
                     for cc in range(3):
-                        node, w = stencil_node(st, a, b, cc, ny, nz)
-                        d0, d1, d2 = stencil_offset(st, a, b, cc, G.dx)
+                        w = wab * st.wz[cc]
+                        d2 = stencil_axis_offset(st, 2, cc, dx)
+                        wk = w * k_stress
+                        node = row + cc
                         buf[node, 0] += w * m
-                        buf[node, 1] += w * (mv0 + q00 * d0 + q01 * d1 + q02 * d2)
-                        buf[node, 2] += w * (mv1 + q10 * d0 + q11 * d1 + q12 * d2)
-                        buf[node, 3] += w * (mv2 + q20 * d0 + q21 * d1 + q22 * d2)
-                        buf[node, 4] += w * k_stress * (s[0] * d0 + s[5] * d1 + s[4] * d2)
-                        buf[node, 5] += w * k_stress * (s[5] * d0 + s[1] * d1 + s[3] * d2)
-                        buf[node, 6] += w * k_stress * (s[4] * d0 + s[3] * d1 + s[2] * d2)
+                        buf[node, 1] += w * (r1 + q02 * d2)
+                        buf[node, 2] += w * (r2 + q12 * d2)
+                        buf[node, 3] += w * (r3 + q22 * d2)
+                        buf[node, 4] += wk * (f1 + s4 * d2)
+                        buf[node, 5] += wk * (f2 + s3 * d2)
+                        buf[node, 6] += wk * (f3 + s2 * d2)
 
 
 @njit(cache=True, inline="always")
@@ -269,7 +287,8 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
     n = p_hi - p_lo
     n_chunks = G.buf.shape[0]
     ny, nz = G.shape[1], G.shape[2]
-    inv_dx = 1.0 / G.dx
+    dx = G.dx
+    inv_dx = 1.0 / dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
         buf = G.buf[c]
@@ -292,20 +311,30 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
             b20 = 0.0
             b21 = 0.0
             b22 = 0.0
+            # x and y parts of each node's weight and offset taken once per (a, b) row: w = (wx wy) wz as per node
             for a in range(3):
+                wa = st.wx[a]
+                d0 = stencil_axis_offset(st, 0, a, dx)
                 for b in range(3):
+                    wab = wa * st.wy[b]
+                    d1 = stencil_axis_offset(st, 1, b, dx)
+                    row = stencil_row(st, a, b, ny, nz)
                     for cc in range(3):
-                        node, w = stencil_node(st, a, b, cc, ny, nz)
-                        d0, d1, d2 = stencil_offset(st, a, b, cc, G.dx)
-                        gv0 = w * grid_v[node, 0]
-                        gv1 = w * grid_v[node, 1]
-                        gv2 = w * grid_v[node, 2]
+                        w = wab * st.wz[cc]
+                        d2 = stencil_axis_offset(st, 2, cc, dx)
+                        node = row + cc
+                        g0 = grid_v[node, 0]
+                        g1 = grid_v[node, 1]
+                        g2 = grid_v[node, 2]
+                        gv0 = w * g0
+                        gv1 = w * g1
+                        gv2 = w * g2
                         v0 += gv0
                         v1 += gv1
                         v2 += gv2
-                        dv0 += w * (grid_v[node, 0] - grid_v[node, 3])
-                        dv1 += w * (grid_v[node, 1] - grid_v[node, 4])
-                        dv2 += w * (grid_v[node, 2] - grid_v[node, 5])
+                        dv0 += w * (g0 - grid_v[node, 3])
+                        dv1 += w * (g1 - grid_v[node, 4])
+                        dv2 += w * (g2 - grid_v[node, 5])
                         b00 += gv0 * d0
                         b01 += gv0 * d1
                         b02 += gv0 * d2
@@ -335,11 +364,14 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
                 wm = mass[p]
                 wt = wm * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2])
                 for a in range(3):
+                    wa = st.wx[a]
                     for b in range(3):
+                        wab = wa * st.wy[b]
+                        row = stencil_row(st, a, b, ny, nz)
                         for cc in range(3):
-                            node, w = stencil_node(st, a, b, cc, ny, nz)
-                            buf[node, 0] += w * wm
-                            buf[node, 1] += w * wt
+                            w = wab * st.wz[cc]
+                            buf[row + cc, 0] += w * wm
+                            buf[row + cc, 1] += w * wt
 
 
 @njit(cache=True, parallel=True)
