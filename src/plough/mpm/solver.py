@@ -440,6 +440,14 @@ def move_sphere(sph: SphereState, c: Constants) -> None:
         sph.slid_m += c.dt * sph.velocity[0]
 
 
+def elastic_energy(s: State, c: Constants) -> float:
+    """Elastic energy of the block, J: the active particles' (``transfers.elastic_energies``, summed over the
+    chunks as ``g2p_update`` deals them) and what the frozen ones keep. Called where it is recorded, not every
+    step."""
+    transfers.elastic_energies(s.particles, c.table, s.zone.ranges(), s.work.acc, transfers.G2P_BLOCK)
+    return float(s.work.acc[:, transfers.ACC_ELASTIC].sum()) + s.zone.frozen_elastic_J
+
+
 def account_energy(w: Work) -> None:
     out = w.contact_out
     # sphere power x dt = work on the material + interface slip loss + inelastic normal impact loss

@@ -55,7 +55,7 @@ from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update
 from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row
 
-# per-chunk accumulators written by g2p_update
+# per-chunk accumulators written by g2p_update (ACC_ELASTIC by elastic_energies, on the steps that need it)
 ACC_PLASTIC_WORK = 0
 ACC_KINETIC = 1
 ACC_ELASTIC = 2
@@ -386,7 +386,7 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     they follow C (G.div and L_buf are not read). Writes P.x (x += dt v_grid), J, stress, eps_p,
     temperature, sigma_y0 and deps_last (the flow stress at rest and the last plastic increment,
     updated where the particle flowed), P.near (1 if within S.near_dist of the sphere surface), and
-    per-chunk accumulators acc[c, :] (plastic work, kinetic and elastic energy, adiabatic heat,
+    per-chunk accumulators acc[c, :] (plastic work, kinetic energy, adiabatic heat,
     deepest penetration of a particle centre into the sphere, worst instability code and the particle
     showing it; a particle outside [Z.check_lo, Z.check_hi] has left the grid). Each particle writes
     only its own entries, chunk c only acc[c] and L_buf[c]: race-free.
@@ -399,7 +399,7 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     contiguous slab per chunk (the earlier split, whose slab ends could lie one particle off).
     """
     x, v, C, stress, J, vol0, mass, near = P.x, P.v, P.C, P.stress, P.J, P.vol0, P.mass, P.near
-    mat_a, mat_b, frac_a, table, taylor_quinney = P.mat_a, P.mat_b, P.frac_a, M.table, M.taylor_quinney
+    taylor_quinney = M.taylor_quinney
     sphere_c, sphere_r, grid_lo, grid_hi = S.centre, S.radius, Z.check_lo, Z.check_hi
     p_lo, p_hi = Z.p_lo, Z.p_hi
     n_chunks = acc.shape[0]
@@ -409,7 +409,6 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     for c in prange(n_chunks):
         wp_sum = 0.0
         ke_sum = 0.0
-        el_sum = 0.0
         heat_sum = 0.0
         pen_max = -1e300
         bad = BAD_NONE
@@ -427,8 +426,6 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
                 vol = vol0[p] * J_new
                 wp_sum += w_pl * vol
                 heat_sum += taylor_quinney * w_pl * vol
-                K, G_shear = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
-                el_sum += elastic_energy_density(stress, p, K, G_shear) * vol
                 ke_sum += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
                 x0 = x[p, 0] + dt * v_grid[p, 0]
                 x1 = x[p, 1] + dt * v_grid[p, 1]
@@ -457,7 +454,6 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
                     bad_p = p
         acc[c, ACC_PLASTIC_WORK] = wp_sum
         acc[c, ACC_KINETIC] = ke_sum
-        acc[c, ACC_ELASTIC] = el_sum
         acc[c, ACC_HEAT] = heat_sum
         acc[c, ACC_PENETRATION] = pen_max
         acc[c, ACC_BAD] = bad
@@ -500,6 +496,30 @@ def _det_i_plus(dt, L):
     a21 = dt * L[2, 1]
     a22 = 1.0 + dt * L[2, 2]
     return a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) + a02 * (a10 * a21 - a11 * a20)
+
+
+@njit(cache=True, parallel=True)
+def elastic_energies(P, table, Z, acc, block):
+    """The elastic energy of the active particles, per chunk, as ``g2p_update`` deals them.
+
+    Reads P.stress, P.vol0, P.J and the materials (P.mat_a, mat_b, frac_a, rows of the packed ``table``) of
+    the particles Z.p_lo <= p < Z.p_hi; writes acc[c, ACC_ELASTIC] = sum of s:s / (4 G) + p^2 / (2 K) times
+    the volume over chunk c's blocks of ``block`` particles (the split of ``g2p_update``, so the sum over the
+    chunks is the one it would give). Only the recorded steps need it (the run's energy account), so it is not
+    part of the step. Chunk c writes only acc[c]: race-free.
+    """
+    stress, J, vol0, mat_a, mat_b, frac_a = P.stress, P.J, P.vol0, P.mat_a, P.mat_b, P.frac_a
+    p_lo, p_hi = Z.p_lo, Z.p_hi
+    n_chunks = acc.shape[0]
+    n_blocks = (p_hi - p_lo + block - 1) // block
+    for c in prange(n_chunks):
+        el_sum = 0.0
+        for blk in range(c, n_blocks, n_chunks):
+            for p in range(p_lo + blk * block, min(p_lo + (blk + 1) * block, p_hi)):
+                vol = vol0[p] * J[p]
+                K, G_shear = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
+                el_sum += elastic_energy_density(stress, p, K, G_shear) * vol
+        acc[c, ACC_ELASTIC] = el_sum
 
 
 @njit(cache=True)
