@@ -82,6 +82,7 @@ def measure(scene_file: Path, h_um: float, block: str, steps: int, threads: int,
         solver.step(state, const)
     setup_s = time.perf_counter() - t0
     zone = getattr(state, "zone", None)
+    zone = getattr(zone, "ranges", zone)  # the zone's ranges: on the zone itself in earlier trees
     worked = 0
     timed = 0
     t0 = time.perf_counter()

@@ -157,7 +157,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
-            active_particle_steps += state.zone.p_hi - state.zone.p_lo
+            active_particle_steps += state.zone.ranges.p_hi - state.zone.ranges.p_lo
             rec.add(state, const)
             if stopper is not None and state.sphere.phase == "slide" and stopper.steady(rec, state.sphere.slid_m):
                 slid_distance = state.sphere.slid_m

@@ -80,8 +80,17 @@ def stencil_node(s, a, b, c, ny, nz):
 @njit(cache=True, inline="always")
 def stencil_axis_offset(s, axis, a, dx):
     """Component ``axis`` of x_i - x_p, m, for the stencil's nodes of index ``a`` along that axis (grid of cell
-    size ``dx``): the kernels take it once per loop level (x in the outer loop, z in the inner one)."""
+    size ``dx``)."""
     return (s.base[axis] + a - s.g[axis]) * dx
+
+
+@njit(cache=True, inline="always")
+def stencil_row_weight(s, a, b, ny, nz, dx):
+    """What the stencil's row (a, b) of three nodes along z shares: the flat index of node (a, b, 0) (node
+    (a, b, c) is that + c), the weight wx[a] wy[b] (node (a, b, c): that times wz[c], the product of
+    :func:`stencil_node`) and the x and y components of x_i - x_p, m. The kernels take them once per row."""
+    return (stencil_row(s, a, b, ny, nz), s.wx[a] * s.wy[b], stencil_axis_offset(s, 0, a, dx),
+            stencil_axis_offset(s, 1, b, dx))
 
 
 @njit(cache=True, inline="always")

@@ -53,7 +53,7 @@ from numba import njit, prange
 
 from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
 from plough.mpm.grid import FIXED, GHOST, MIRROR
-from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row
+from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row, stencil_row_weight
 
 # per-chunk accumulators written by g2p_update (ACC_ELASTIC by elastic_energies, on the steps that need it)
 ACC_PLASTIC_WORK = 0
@@ -113,12 +113,8 @@ def p2g(P, G, dt, Z):
             # the x and y parts of each sum are taken once per (a, b) row of three nodes, in the order the sums
             # are written in (w = (wx wy) wz, (mv + q d0 + q d1) + q d2): the same round-off as per node
             for a in range(3):
-                wa = st.wx[a]
-                d0 = stencil_axis_offset(st, 0, a, dx)
                 for b in range(3):
-                    wab = wa * st.wy[b]
-                    d1 = stencil_axis_offset(st, 1, b, dx)
-                    row = stencil_row(st, a, b, ny, nz)
+                    row, wab, d0, d1 = stencil_row_weight(st, a, b, ny, nz, dx)
                     r1 = mv0 + q00 * d0 + q01 * d1
                     r2 = mv1 + q10 * d0 + q11 * d1
                     r3 = mv2 + q20 * d0 + q21 * d1
@@ -313,12 +309,8 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
             b22 = 0.0
             # x and y parts of each node's weight and offset taken once per (a, b) row: w = (wx wy) wz as per node
             for a in range(3):
-                wa = st.wx[a]
-                d0 = stencil_axis_offset(st, 0, a, dx)
                 for b in range(3):
-                    wab = wa * st.wy[b]
-                    d1 = stencil_axis_offset(st, 1, b, dx)
-                    row = stencil_row(st, a, b, ny, nz)
+                    row, wab, d0, d1 = stencil_row_weight(st, a, b, ny, nz, dx)
                     for cc in range(3):
                         w = wab * st.wz[cc]
                         d2 = stencil_axis_offset(st, 2, cc, dx)
@@ -364,10 +356,8 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
                 wm = mass[p]
                 wt = wm * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2])
                 for a in range(3):
-                    wa = st.wx[a]
                     for b in range(3):
-                        wab = wa * st.wy[b]
-                        row = stencil_row(st, a, b, ny, nz)
+                        row, wab, _, _ = stencil_row_weight(st, a, b, ny, nz, dx)
                         for cc in range(3):
                             w = wab * st.wz[cc]
                             buf[row + cc, 0] += w * wm
