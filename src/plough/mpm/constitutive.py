@@ -566,8 +566,10 @@ def update_stress(P, p, L, dt, M):
         1.5 * (n11 * n11 + n22 * n22 + n33 * n33 + 2.0 * (n23 * n23 + n13 * n13 + n12 * n12))
     )
     T = temperature[p]
-    deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sigma_y0[p],
-                                        deps_last[p])
+    deps, sig_y = 0.0, sigma_y0[p]
+    if q_trial > sig_y:  # only a plastic trial state calls the return map (an elastic one would return these)
+        deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sig_y,
+                                            deps_last[p])
     w = 0.0
     if deps > 0.0:
         scale = sig_y / q_trial
