@@ -51,6 +51,7 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from plough.mpm.bundles import StressState
 from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
 from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row, stencil_row_weight
@@ -390,6 +391,7 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     """
     x, v, C, stress, J, vol0, mass, near = P.x, P.v, P.C, P.stress, P.J, P.vol0, P.mass, P.near
     taylor_quinney = M.taylor_quinney
+    SP = StressState(P.stress, P.J, P.eps_p, P.temperature, P.sigma_y0, P.deps_last, P.mat_a, P.mat_b, P.frac_a)
     sphere_c, sphere_r, grid_lo, grid_hi = S.centre, S.radius, Z.check_lo, Z.check_hi
     p_lo, p_hi = Z.p_lo, Z.p_hi
     n_chunks = acc.shape[0]
@@ -412,7 +414,7 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
                     _with_dilatation(Cp, _gather_scalar(G.div, x, p, G.origin, inv_dx, ny, nz), L)
                 J_new = J[p] * _det_i_plus(dt, L)
                 J[p] = J_new
-                deps, w_pl = update_stress(P, p, L, dt, M)
+                deps, w_pl = update_stress(SP, p, L, dt, M)  # the stress fields only: a cheaper call
                 vol = vol0[p] * J_new
                 wp_sum += w_pl * vol
                 heat_sum += taylor_quinney * w_pl * vol
