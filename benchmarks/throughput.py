@@ -44,7 +44,9 @@ from datetime import date
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-PEER_DIR = ROOT.parent / "shared" / "peer-bench"
+#: ../shared/peer-bench beside the checkout, or beside the folder of a git worktree (wt/NAME)
+PEER_DIR = next((d for d in (ROOT.parent / "shared" / "peer-bench", ROOT.parents[1] / "shared" / "peer-bench")
+                 if d.is_dir()), ROOT.parent / "shared" / "peer-bench")
 #: steps run into the slide before the clock starts
 WARM_SLIDE_STEPS = 20
 #: name: (scene file, default particle size in um, block: "paper" (the file's domain) or "sized")
