@@ -44,7 +44,9 @@ from datetime import date
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-PEER_DIR = ROOT.parent / "shared" / "peer-bench"
+#: ../shared/peer-bench beside the checkout, or beside the folder of a git worktree (wt/NAME)
+PEER_DIR = next((d for d in (ROOT.parent / "shared" / "peer-bench", ROOT.parents[1] / "shared" / "peer-bench")
+                 if d.is_dir()), ROOT.parent / "shared" / "peer-bench")
 #: steps run into the slide before the clock starts
 WARM_SLIDE_STEPS = 20
 #: name: (scene file, default particle size in um, block: "paper" (the file's domain) or "sized")
@@ -82,6 +84,7 @@ def measure(scene_file: Path, h_um: float, block: str, steps: int, threads: int,
         solver.step(state, const)
     setup_s = time.perf_counter() - t0
     zone = getattr(state, "zone", None)
+    zone = getattr(zone, "ranges", zone)  # the zone's ranges: on the zone itself in earlier trees
     worked = 0
     timed = 0
     t0 = time.perf_counter()

@@ -321,8 +321,8 @@ def test_a_particle_past_the_far_end_lengthens_the_automatic_grid_up_to_its_limi
     assert far + dx + 0.25 * r <= const.grid_hi[0] < far + 2.0 * dx + 0.25 * r
     assert list(const.shape) == list(const.grid.shape) and np.array_equal(const.grid.origin, solver.init(
         tiny_scene, n_chunks=1)[1].grid.origin)
-    assert state.zone.check_hi_m[0] == const.grid_hi[0] and state.zone.n_hi == const.grid.n_nodes
-    assert state.zone.i_free_hi == const.grid.shape[0]  # the new layers are free, not clamped
+    assert state.zone.ranges.check_hi[0] == const.grid_hi[0] and state.zone.ranges.n_hi == const.grid.n_nodes
+    assert state.zone.ranges.i_free_hi == const.grid.shape[0]  # the new layers are free, not clamped
     assert state.grid_extensions == [(state.step, state.sphere.slid_m, float(const.grid_hi[0]))]
     assert np.array_equal(state.work.flags, boundary_flags(const.grid, tiny_scene.domain.radius_m, True))
     assert state.work.grid_buf.shape[1] == state.work.grid_m.size == state.work.last_push.size == const.grid.n_nodes
@@ -500,12 +500,13 @@ def test_a_run_whose_grid_was_lengthened_goes_on_as_if_it_had_started_on_the_lon
     lengthened at step 0: same particles, same forces."""
     scene = tiny_scene.with_(discretisation=replace(tiny_scene.discretisation, active_zone_contact_radii=zone))
     late, c_late = solver.init(scene, n_chunks=1)
-    while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6 and late.zone.p_hi == late.particles.n):
+    while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6
+               and late.zone.ranges.p_hi == late.particles.n):
         solver.step(late, c_late)  # until the zone reached the block's end: it must follow the new end
     growth.grow_grid(late, c_late, 0, 6)
     start, c_start = _grown_at_start_and_both_run_on(scene, late, c_late, 0, 6)
-    assert late.zone.n_hi == start.zone.n_hi == c_late.grid.n_nodes
-    assert late.zone.check_hi_m[0] == start.zone.check_hi_m[0] == c_late.grid_hi[0]
+    assert late.zone.ranges.n_hi == start.zone.ranges.n_hi == c_late.grid.n_nodes
+    assert late.zone.ranges.check_hi[0] == start.zone.ranges.check_hi[0] == c_late.grid_hi[0]
     _assert_same_run(late, start, scene)
 
 
@@ -544,7 +545,7 @@ def test_a_particle_past_the_side_widens_the_automatic_grid_up_to_its_limit(tiny
     assert const.grid.shape[0] == nx and const.grid.shape[2] == nz and const.grid.shape[1] > ny
     assert far + dx + 0.25 * r <= const.grid_hi[1] < far + 2.0 * dx + 0.25 * r
     assert list(const.shape) == list(const.grid.shape)
-    assert state.zone.check_hi_m[1] == const.grid_hi[1] and state.zone.n_hi == const.grid.n_nodes
+    assert state.zone.ranges.check_hi[1] == const.grid_hi[1] and state.zone.ranges.n_hi == const.grid.n_nodes
     assert state.grid_widenings == [(state.step, state.sphere.slid_m, float(const.grid_hi[1]))]
     new_ny = const.grid.shape[1]
     flags = state.work.flags.reshape(nx, new_ny, nz)
@@ -628,14 +629,15 @@ def test_a_run_whose_grid_was_widened_goes_on_as_if_it_had_started_on_the_wider_
     late, c_late = solver.init(scene, n_chunks=1)
     while not (late.sphere.phase == "slide" and late.sphere.slid_m >= 10e-6):
         solver.step(late, c_late)
-    old_slab, slabs = c_late.grid.shape[1] * c_late.grid.shape[2], (late.zone.n_lo, late.zone.n_hi)
+    old_slab, slabs = c_late.grid.shape[1] * c_late.grid.shape[2], (late.zone.ranges.n_lo, late.zone.ranges.n_hi)
     growth.grow_grid(late, c_late, 1, 5)
     new_slab = c_late.grid.shape[1] * c_late.grid.shape[2]
-    assert (late.zone.n_lo, late.zone.n_hi) == (slabs[0] // old_slab * new_slab, slabs[1] // old_slab * new_slab)
+    assert (late.zone.ranges.n_lo, late.zone.ranges.n_hi) == (slabs[0] // old_slab * new_slab,
+                                                              slabs[1] // old_slab * new_slab)
     start, c_start = _grown_at_start_and_both_run_on(scene, late, c_late, 1, 5)
-    assert (late.zone.n_lo, late.zone.n_hi) == (start.zone.n_lo, start.zone.n_hi)
-    assert (late.zone.p_hi - late.zone.p_lo < late.particles.n) == (zone is not None)
-    assert late.zone.check_hi_m[1] == start.zone.check_hi_m[1] == c_late.grid_hi[1]
+    assert (late.zone.ranges.n_lo, late.zone.ranges.n_hi) == (start.zone.ranges.n_lo, start.zone.ranges.n_hi)
+    assert (late.zone.ranges.p_hi - late.zone.ranges.p_lo < late.particles.n) == (zone is not None)
+    assert late.zone.ranges.check_hi[1] == start.zone.ranges.check_hi[1] == c_late.grid_hi[1]
     _assert_same_run(late, start, scene)
 
 
@@ -649,7 +651,7 @@ def test_a_particle_above_the_automatic_grid_top_raises_it(tiny_scene):
     assert (nx, ny) == old_shape[:2] and nz > old_shape[2]
     assert 2.0 * old_top <= const.grid_hi[2] < 2.0 * old_top + const.grid.dx
     assert const.grid_hi[2] == pytest.approx(const.grid.upper[2] - const.grid.dx, rel=1e-12)
-    assert state.zone.check_hi_m[2] == const.grid_hi[2] and list(const.shape) == [nx, ny, nz]
+    assert state.zone.ranges.check_hi[2] == const.grid_hi[2] and list(const.shape) == [nx, ny, nz]
     assert state.grid_raises == [(state.step, state.sphere.slid_m, float(const.grid_hi[2]))]
     flags = state.work.flags.reshape(nx, ny, nz)
     assert np.array_equal(flags[:, :, :old_shape[2]], old_flags.reshape(old_shape))
@@ -736,7 +738,7 @@ def test_a_run_whose_grid_top_was_raised_goes_on_as_if_it_had_started_on_the_tal
     for _ in range(150):
         solver.step(raised_late, c_late)
     assert from_start.step == raised_late.step and raised_late.sphere.slid_m > 10e-6
-    assert (raised_late.zone.p_hi - raised_late.zone.p_lo < raised_late.particles.n) == (zone is not None)
+    assert (raised_late.zone.ranges.p_hi - raised_late.zone.ranges.p_lo < raised_late.particles.n) == (zone is not None)
     _assert_same_run(raised_late, from_start, scene)
 
 
@@ -892,7 +894,7 @@ def test_active_zone_follows_the_sphere_and_freezes_what_it_leaves(tiny_scene, n
     left keep their position and stress, those it has not reached are untouched, and the grid
     slabs it has left hold zero velocity."""
     state, const = solver.init(zoned(tiny_scene, 2.0), n_chunks=1)
-    p, z = state.particles, state.zone
+    p = state.particles
     seeded = p.x.copy()
     half_width = 2.0 * tiny_scene.expected_contact()[0]
     assert const.zone_half_width_m == pytest.approx(half_width)
@@ -903,6 +905,7 @@ def test_active_zone_follows_the_sphere_and_freezes_what_it_leaves(tiny_scene, n
     while state.sphere.phase != "done":
         xc = state.sphere.centre[0]  # where the step's zone update sees the sphere
         solver.step(state, const)
+        z = state.zone.ranges  # the ranges the step worked on (each update replaces them)
         ranges.append((z.p_lo, z.p_hi, z.n_lo, z.n_hi, z.i_free_lo, z.i_free_hi))
         # every active particle's stencil (x slabs bx .. bx + 2) lies in the node range the step worked on
         bx = np.floor((p.x[z.p_lo:z.p_hi, 0] - g.origin[0]) / g.dx - 0.5)
@@ -935,9 +938,9 @@ def test_a_particle_leaving_the_active_zone_stops_the_run_naming_the_zone(tiny_s
     state, const = solver.init(zoned(tiny_scene, 2.0), n_chunks=1)
     while state.sphere.phase != "slide":
         solver.step(state, const)
-    z = state.zone
+    z = state.zone.ranges
     assert z.p_hi < state.particles.n  # the zone's front clamp is on
-    state.particles.x[z.p_hi - 1, 0] = z.check_hi_m[0] + 0.5 * const.grid.dx  # pushed past the zone's slabs
+    state.particles.x[z.p_hi - 1, 0] = z.check_hi[0] + 0.5 * const.grid.dx  # pushed past the zone's slabs
     with pytest.raises(solver.SimulationError, match=r"active zone's grid slabs.*active_zone_contact_radii"):
         solver.step(state, const)
 

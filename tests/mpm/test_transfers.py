@@ -340,11 +340,19 @@ def test_g2p_update_blocks_cover_every_particle_once():
         Z = whole(n, SHAPE, lo, hi)._replace(p_lo=p_lo, p_hi=p_hi)
         tr.g2p_update(P, G, MaterialData(soft, 1.0, 0.9), SphereData(x.mean(0), np.zeros(3), 4 * DX, DX), Z, 1e-8, 1,
                       v_grid, tr.allocate_velocity_gradient_scratch(n_chunks), acc, block)
+        tr.elastic_energies(P, soft, Z, acc, block)  # the energy the recorder takes, split as g2p_update splits
         return acc, (xs, ss, Js, near, eps_p, temperature, sigma_y0, deps_last)
 
     acc_ref, ref = run(1, n)
     flowed = int((ref[4] > 0.0).sum())
     assert 0 < flowed < n and 0 < ref[3].sum() < n
+    # the elastic energy is s:s / (4 G) + p^2 / (2 K) of the updated stress times the current volume
+    sig, K, G_shear = ref[1], soft[0, I_K], soft[0, I_G]
+    pressure = sig[:, :3].mean(1)
+    dev = sig[:, :3] - pressure[:, None]
+    ss = (dev**2).sum(1) + 2.0 * (sig[:, 3:] ** 2).sum(1)
+    assert acc_ref[0, tr.ACC_ELASTIC] == pytest.approx(
+        ((ss / (4.0 * G_shear) + pressure**2 / (2.0 * K)) * vol0 * ref[2]).sum(), rel=1e-12)
     for n_chunks, block in [(1, tr.G2P_BLOCK), (2, 1), (3, 7), (3, 8), (2, (n + 1) // 2), (3, n), (4, 64)]:
         acc, got = run(n_chunks, block)
         for a, b in zip(got, ref, strict=True):

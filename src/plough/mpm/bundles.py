@@ -11,6 +11,7 @@ arrays, so building one copies nothing and a kernel's writes land in the run's s
 - ``M``, :class:`MaterialData`: the packed flow laws and the constants of the stress update;
 - ``S``, :class:`SphereData`: the rigid sphere, where it is and how it moves;
 - ``law``, :class:`ContactLaw`: the interface shear law and the contact's hold;
+- ``SP``, :class:`StressState`: the particles' stress fields alone, what ``g2p_update`` hands the stress update;
 - ``Z``, :class:`Zone`: the particle and node ranges a step works on (the active zone) and the box the
   particles must stay in.
 
@@ -66,6 +67,23 @@ class ContactLaw(NamedTuple):
     params: np.ndarray  # (2,) the law's parameters (f; tau; Cp, np)
     hold_steps: float  # a node (or a particle) stays in contact this many steps after its last normal push
     sweeps: int = 4  # projected Gauss-Seidel sweeps of particle_contact over the touching particles
+
+
+class StressState(NamedTuple):
+    """The particle fields the stress update reads and writes (``SP``, ``constitutive.update_stress``), a subset of
+    ``P``'s: ``g2p_update`` passes this to the update of each particle instead of ``P``, because a bundle is passed
+    by value (each array's pointer, shape and strides), and the nine arrays cost the call less than all of ``P``'s
+    (g2p_update on one thread, 10% less time on an elastic block: docs/journal/2026-12-02-throughput.md)."""
+
+    stress: np.ndarray  # (n, 6) Voigt xx, yy, zz, yz, xz, xy, Pa
+    J: np.ndarray  # (n,) det F
+    eps_p: np.ndarray  # (n,) equivalent plastic strain
+    temperature: np.ndarray  # (n,) K
+    sigma_y0: np.ndarray  # (n,) flow stress at rest, Pa
+    deps_last: np.ndarray  # (n,) last plastic strain increment
+    mat_a: np.ndarray  # (n,) int32 material row a
+    mat_b: np.ndarray  # (n,) int32 material row b
+    frac_a: np.ndarray  # (n,) volume fraction of a
 
 
 class Zone(NamedTuple):

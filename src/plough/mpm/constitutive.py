@@ -475,7 +475,8 @@ def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, 
 def update_stress(P, p, L, dt, M):
     """Advance the Cauchy stress of particle ``p`` by one step (eqs. 6.1 and 6.2).
 
-    Reads, of the particles ``P`` (:class:`plough.mpm.particles.Particles`): ``P.stress[p]`` ((n, 6) Voigt
+    Reads, of the particles ``P`` (:class:`plough.mpm.particles.Particles`, or the bundle of its stress fields
+    :class:`plough.mpm.bundles.StressState`, which ``g2p_update`` passes): ``P.stress[p]`` ((n, 6) Voigt
     xx, yy, zz, yz, xz, xy; only its deviator is used), ``P.J[p]`` (det F after this step: the caller
     updates it first), ``P.eps_p[p]``, ``P.temperature[p]``, ``P.sigma_y0[p]`` (the flow stress at rest
     sigma_y(eps_p[p], 0, temperature[p]), kept by :func:`rest_flow_stresses`), ``P.deps_last[p]`` (the
@@ -566,8 +567,10 @@ def update_stress(P, p, L, dt, M):
         1.5 * (n11 * n11 + n22 * n22 + n33 * n33 + 2.0 * (n23 * n23 + n13 * n13 + n12 * n12))
     )
     T = temperature[p]
-    deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sigma_y0[p],
-                                        deps_last[p])
+    deps, sig_y = 0.0, sigma_y0[p]
+    if q_trial > sig_y:  # only a plastic trial state calls the return map (an elastic one would return these)
+        deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sig_y,
+                                            deps_last[p])
     w = 0.0
     if deps > 0.0:
         scale = sig_y / q_trial

@@ -110,7 +110,7 @@ def hold(s: State, c: Constants, index: int) -> int:
     stuck = _outside_for_good(s, c)
     if stuck >= 0:
         return stuck
-    z = s.zone
+    z = s.zone.ranges
     x = s.particles.x[z.p_lo:z.p_hi]
     layers = {axis: _layers_past(s, c, axis) for axis in FACES}
     for axis in (0, 1, 2):
@@ -143,7 +143,7 @@ def grow_face(s: State, c: Constants, axis: int, then: tuple[tuple[int, int], ..
     limit_m = getattr(c, face.limit)
     if limit_m <= 0.0:
         return False
-    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, axis].max())
+    far = float(s.particles.x[s.zone.ranges.p_lo:s.zone.ranges.p_hi, axis].max())
     need_m = far + c.grid.dx
     if face.doubles:
         want_m = max(2.0 * float(c.grid_hi[axis]), need_m)
@@ -159,20 +159,20 @@ def _outside_for_good(s: State, c: Constants) -> int:
     """An active particle outside the positions check's box other than above the grid's top, past its far
     end or past its side where the grid may widen (through the bottom, the low side, the near end, the side
     of a grid that does not widen, or out of the active zone's slabs), -1 if none."""
-    z = s.zone
+    z = s.zone.ranges
     x = s.particles.x[z.p_lo:z.p_hi]
-    low = np.any(x < z.check_lo_m, axis=1)
-    side = x[:, 1] > z.check_hi_m[1] if c.grid_side_limit_m <= 0.0 else np.zeros(len(x), dtype=bool)
-    zone = (x[:, 0] > z.check_hi_m[0]) & (x[:, 0] <= c.grid_hi[0])
+    low = np.any(x < z.check_lo, axis=1)
+    side = x[:, 1] > z.check_hi[1] if c.grid_side_limit_m <= 0.0 else np.zeros(len(x), dtype=bool)
+    zone = (x[:, 0] > z.check_hi[0]) & (x[:, 0] <= c.grid_hi[0])
     out = np.flatnonzero(low | side | zone)
     return int(z.p_lo + out[0]) if out.size else -1
 
 
 def _outside_index(s: State) -> int:
     """An active particle outside the positions check's box, -1 if none."""
-    z = s.zone
+    z = s.zone.ranges
     x = s.particles.x[z.p_lo:z.p_hi]
-    out = np.flatnonzero(np.any((x < z.check_lo_m) | (x > z.check_hi_m), axis=1))
+    out = np.flatnonzero(np.any((x < z.check_lo) | (x > z.check_hi), axis=1))
     return int(z.p_lo + out[0]) if out.size else -1
 
 
@@ -183,7 +183,7 @@ def _layers_past(s: State, c: Constants, axis: int) -> int:
     limit_m = getattr(c, FACES[axis].limit)
     if limit_m <= 0.0:
         return 0
-    far = float(s.particles.x[s.zone.p_lo:s.zone.p_hi, axis].max())
+    far = float(s.particles.x[s.zone.ranges.p_lo:s.zone.ranges.p_hi, axis].max())
     now = float(c.grid_hi[axis])
     if far <= now:
         return 0
@@ -226,7 +226,7 @@ def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
     and positions check follow the new far end where they reached the old one. A particle outside the old
     grid on this step moved with a complete stencil on it (it was inside before the move).
     """
-    g, z, w = c.grid, s.zone, s.work
+    g, z, w = c.grid, s.zone.ranges, s.work
     shape, new = g.shape, grown(g, extra, axis)
     w.grid_buf = extend_node_array(w.grid_buf, shape, extra, axis=1, fill=0.0, grid_axis=axis)
     w.grid_m = extend_node_array(w.grid_m, shape, extra, fill=0.0, grid_axis=axis)
@@ -237,14 +237,14 @@ def grow_grid(s: State, c: Constants, axis: int, extra: int) -> None:
     w.flags = extend_node_array(w.flags, shape, extra, grid_axis=axis)
     old_slab, new_slab = shape[1] * shape[2], new.shape[1] * new.shape[2]
     if axis in (1, 2):  # x-major: the zone's node range keeps its slabs, each slab taller or wider
-        z.n_lo, z.n_hi = z.n_lo // old_slab * new_slab, z.n_hi // old_slab * new_slab
+        s.zone.ranges = z._replace(n_lo=z.n_lo // old_slab * new_slab, n_hi=z.n_hi // old_slab * new_slab)
     else:  # the slabs keep their size; a zone that reached the old far end reaches the new one
-        z.n_hi = new.n_nodes if z.n_hi == g.n_nodes else z.n_hi
-        z.i_free_hi = new.shape[0] if z.i_free_hi == shape[0] else z.i_free_hi
+        s.zone.ranges = z._replace(n_hi=new.n_nodes if z.n_hi == g.n_nodes else z.n_hi,
+                                   i_free_hi=new.shape[0] if z.i_free_hi == shape[0] else z.i_free_hi)
     old_hi = c.grid_hi.copy()
     c.growing.set(new)
-    if z.check_hi_m[axis] == old_hi[axis]:
-        z.check_hi_m[axis] = c.grid_hi[axis]
+    if z.check_hi[axis] == old_hi[axis]:
+        z.check_hi[axis] = c.grid_hi[axis]
 
 
 # ----------------------------------------------------------------------------- memory

@@ -59,7 +59,7 @@ class _Recorder:
             "particle_penetration": pen, "contact_area_xy": k * float(w.contact_out[contact.OUT_AREA_XY]),
             "material_top": float(s.particles.x[:, 2].max()),
             "external_work": k * w.external_work, "plastic_work": k * w.plastic_work,
-            "elastic_energy": k * (float(acc[:, transfers.ACC_ELASTIC].sum()) + s.zone.frozen_elastic_J),
+            "elastic_energy": k * solver.elastic_energy(s, c),
             "kinetic_energy": k * float(acc[:, transfers.ACC_KINETIC].sum()),
             "interface_dissipation": k * w.interface_dissipation, "contact_impact_loss": k * w.contact_impact_loss,
             "frozen_kinetic_loss": k * s.zone.frozen_kinetic_loss_J,
@@ -157,7 +157,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
-            active_particle_steps += state.zone.p_hi - state.zone.p_lo
+            active_particle_steps += state.zone.ranges.p_hi - state.zone.ranges.p_lo
             rec.add(state, const)
             if stopper is not None and state.sphere.phase == "slide" and stopper.steady(rec, state.sphere.slid_m):
                 slid_distance = state.sphere.slid_m

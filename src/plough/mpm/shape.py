@@ -78,6 +78,22 @@ def stencil_node(s, a, b, c, ny, nz):
 
 
 @njit(cache=True, inline="always")
+def stencil_axis_offset(s, axis, a, dx):
+    """Component ``axis`` of x_i - x_p, m, for the stencil's nodes of index ``a`` along that axis (grid of cell
+    size ``dx``)."""
+    return (s.base[axis] + a - s.g[axis]) * dx
+
+
+@njit(cache=True, inline="always")
+def stencil_row_weight(s, a, b, ny, nz, dx):
+    """What the stencil's row (a, b) of three nodes along z shares: the flat index of node (a, b, 0) (node
+    (a, b, c) is that + c), the weight wx[a] wy[b] (node (a, b, c): that times wz[c], the product of
+    :func:`stencil_node`) and the x and y components of x_i - x_p, m. The kernels take them once per row."""
+    return (stencil_row(s, a, b, ny, nz), s.wx[a] * s.wy[b], stencil_axis_offset(s, 0, a, dx),
+            stencil_axis_offset(s, 1, b, dx))
+
+
+@njit(cache=True, inline="always")
 def stencil_offset(s, a, b, c, dx):
     """x_i - x_p of the stencil's node (a, b, c), m, on a grid of cell size ``dx``."""
-    return (s.base[0] + a - s.g[0]) * dx, (s.base[1] + b - s.g[1]) * dx, (s.base[2] + c - s.g[2]) * dx
+    return stencil_axis_offset(s, 0, a, dx), stencil_axis_offset(s, 1, b, dx), stencil_axis_offset(s, 2, c, dx)

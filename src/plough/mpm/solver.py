@@ -64,7 +64,7 @@ SETTLE_STEPS = 300
 INTEGRAL_STEPS = 100.0
 #: grid slabs worked on beyond each clamp face of the active zone, so that the stencils of the
 #: active particles stay on nodes the step updates: a particle at its starting position keeps two
-#: slabs to spare, one of which the positions check (``ActiveZone.check_lo_m``) may use up: a
+#: slabs to spare, one of which the positions check (the zone's ``check_lo``, :class:`ActiveZone`) may use up: a
 #: particle moved about a cell past its start at the zone's end (material the sphere pushes far
 #: ahead) stops the run
 ZONE_PAD_CELLS = 4
@@ -164,30 +164,19 @@ class Constants:
 
 @dataclass
 class ActiveZone:
-    """The particles [p_lo, p_hi) and flat grid nodes [n_lo, n_hi) a step works on.
+    """The zone a step works on, and the energy of the particles it has left behind (J).
 
-    Nodes of x index below ``i_free_lo`` or above ``i_free_hi`` lie in frozen material and hold
-    zero velocity. Both ranges only move forward: a particle the zone has left stays frozen,
-    with the elastic energy it keeps and the kinetic energy it lost counted here. ``check_lo_m``
-    and ``check_hi_m`` bound the particles' positions (the grid's interior, narrowed in x so that
-    every active particle's stencil stays in [n_lo, n_hi) on the next step).
+    ``ranges`` is the zone as the kernels take it (:class:`plough.mpm.bundles.Zone`: the particles [p_lo, p_hi)
+    and flat grid nodes [n_lo, n_hi); nodes of x index below i_free_lo or above i_free_hi lie in frozen material
+    and hold zero velocity; check_lo and check_hi bound the particles' positions: the grid's interior, narrowed
+    in x so that every active particle's stencil stays in [n_lo, n_hi) on the next step). The ranges only move
+    forward (:func:`update_active_zone` replaces them): a particle the zone has left stays frozen, with the
+    elastic energy it keeps and the kinetic energy it lost counted here.
     """
 
-    p_lo: int
-    p_hi: int
-    n_lo: int
-    n_hi: int
-    i_free_lo: int
-    i_free_hi: int
-    check_lo_m: np.ndarray = field(default_factory=lambda: np.full(3, -np.inf))
-    check_hi_m: np.ndarray = field(default_factory=lambda: np.full(3, np.inf))
+    ranges: Zone
     frozen_elastic_J: float = 0.0
     frozen_kinetic_loss_J: float = 0.0
-
-    def ranges(self) -> Zone:
-        """The zone bundle ``Z`` the kernels take (its check box arrays are this zone's own)."""
-        return Zone(p_lo=self.p_lo, p_hi=self.p_hi, n_lo=self.n_lo, n_hi=self.n_hi, i_free_lo=self.i_free_lo,
-                    i_free_hi=self.i_free_hi, check_lo=self.check_lo_m, check_hi=self.check_hi_m)
 
 
 @dataclass
@@ -329,11 +318,12 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
         L_buf=transfers.allocate_velocity_gradient_scratch(n_chunks), v_grid=np.zeros((particles.n, 3)),
     )
     sphere = SphereState(centre=centre, velocity=np.array([0.0, 0.0, -const.press_speed]))
+    box = {"check_lo": const.grid_lo.copy(), "check_hi": const.grid_hi.copy()}
     if const.zone_half_width_m > 0.0:  # empty ranges, opened by the first update
-        zone = ActiveZone(p_lo=0, p_hi=0, n_lo=0, n_hi=0, i_free_lo=-1, i_free_hi=-1)
+        zone = ActiveZone(Zone(p_lo=0, p_hi=0, n_lo=0, n_hi=0, i_free_lo=-1, i_free_hi=-1, **box))
     else:
-        zone = ActiveZone(p_lo=0, p_hi=particles.n, n_lo=0, n_hi=grid.n_nodes, i_free_lo=0, i_free_hi=grid.shape[0])
-    zone.check_lo_m, zone.check_hi_m = const.grid_lo.copy(), const.grid_hi.copy()
+        zone = ActiveZone(Zone(p_lo=0, p_hi=particles.n, n_lo=0, n_hi=grid.n_nodes, i_free_lo=0,
+                               i_free_hi=grid.shape[0], **box))
     state = State(particles=particles, sphere=sphere, work=work, zone=zone)
     update_active_zone(state, const)
     return state, const
@@ -356,7 +346,7 @@ def step(s: State, c: Constants) -> None:
     """Advance the state by one time step dt (the module docstring's steps 1-5; the kernels' bundles:
     :mod:`plough.mpm.bundles`)."""
     update_active_zone(s, c)
-    P, G, S, Z, w = s.particles, grid_data(s, c), sphere_data(s, c), s.zone.ranges(), s.work
+    P, G, S, Z, w = s.particles, grid_data(s, c), sphere_data(s, c), s.zone.ranges, s.work
     transfers.p2g(P, G, c.dt, Z)  # 1. P2G
     transfers.grid_update(G, Z)  # 2. grid velocities, boundary conditions
     if c.contact_mode == "particle":  # 3. contact: the sphere on the near particles, through their nodes
@@ -403,7 +393,7 @@ def update_active_zone(s: State, c: Constants) -> None:
     """
     if c.zone_half_width_m <= 0.0:
         return
-    z, w, p = s.zone, s.work, s.particles
+    z, w, p = s.zone.ranges, s.work, s.particles
     g = c.grid
     nx, ny, nz = g.shape
     lo_x = s.sphere.centre[0] - c.zone_half_width_m
@@ -412,8 +402,8 @@ def update_active_zone(s: State, c: Constants) -> None:
     p_hi = max(z.p_hi, int(np.searchsorted(c.zone_x0_m, hi_x, side="right")))
     if p_lo > z.p_lo:
         elastic, kinetic = transfers.freeze_particles(p, w.v_grid, c.table, z.p_lo, p_lo)
-        z.frozen_elastic_J += elastic
-        z.frozen_kinetic_loss_J += kinetic
+        s.zone.frozen_elastic_J += elastic
+        s.zone.frozen_kinetic_loss_J += kinetic
     n = c.zone_x0_m.size
     i_free_lo = math.ceil((lo_x - g.origin[0]) / g.dx) if p_lo > 0 else 0
     i_free_hi = math.floor((hi_x - g.origin[0]) / g.dx) if p_hi < n else nx
@@ -424,11 +414,12 @@ def update_active_zone(s: State, c: Constants) -> None:
         w.grid_m[z.n_lo:n_lo] = 0.0
         w.grid_v[z.n_lo:n_lo] = 0.0
         w.grid_div[z.n_lo:n_lo] = 0.0
-    z.p_lo, z.p_hi, z.n_lo, z.n_hi = p_lo, p_hi, n_lo, n_hi
-    z.i_free_lo, z.i_free_hi = max(z.i_free_lo, i_free_lo), max(z.i_free_hi, i_free_hi)
+    s.zone.ranges = z._replace(p_lo=p_lo, p_hi=p_hi, n_lo=n_lo, n_hi=n_hi, i_free_lo=max(z.i_free_lo, i_free_lo),
+                               i_free_hi=max(z.i_free_hi, i_free_hi))
     # a stencil spans x - 1.5 dx .. x + 1.5 dx; one cell more for the range's advance before the next check
-    z.check_lo_m[0] = c.grid_lo[0] if n_lo == 0 else max(c.grid_lo[0], g.origin[0] + (n_lo // slab + 1.5) * g.dx)
-    z.check_hi_m[0] = c.grid_hi[0] if n_hi == nx * slab else min(c.grid_hi[0],
+    # (the check box's arrays are the zone's own: changed in place)
+    z.check_lo[0] = c.grid_lo[0] if n_lo == 0 else max(c.grid_lo[0], g.origin[0] + (n_lo // slab + 1.5) * g.dx)
+    z.check_hi[0] = c.grid_hi[0] if n_hi == nx * slab else min(c.grid_hi[0],
                                                                  g.origin[0] + (n_hi // slab - 2.5) * g.dx)
 
 
@@ -445,6 +436,14 @@ def move_sphere(sph: SphereState, c: Constants) -> None:
     sph.centre += c.dt * sph.velocity
     if sph.phase == "slide":
         sph.slid_m += c.dt * sph.velocity[0]
+
+
+def elastic_energy(s: State, c: Constants) -> float:
+    """Elastic energy of the block, J: the active particles' (``transfers.elastic_energies``, summed over the
+    chunks as ``g2p_update`` deals them) and what the frozen ones keep. Called where it is recorded, not every
+    step."""
+    transfers.elastic_energies(s.particles, c.table, s.zone.ranges, s.work.acc, transfers.G2P_BLOCK)
+    return float(s.work.acc[:, transfers.ACC_ELASTIC].sum()) + s.zone.frozen_elastic_J
 
 
 def account_energy(w: Work) -> None:
@@ -539,9 +538,9 @@ def check_stability(s: State, c: Constants) -> None:
                      "chip of a soft coating: enlarge domain.radius_m) or a particle flung off the surface (lower "
                      f"mass_scaling or speed){limit}")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
-            zone = s.zone
-            cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo_m[0] * 1e6:.1f}.."
-                     f"{zone.check_hi_m[0] * 1e6:.1f} um), about a cell past its start at the zone's end: material "
+            zone = s.zone.ranges
+            cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo[0] * 1e6:.1f}.."
+                     f"{zone.check_hi[0] * 1e6:.1f} um), about a cell past its start at the zone's end: material "
                      "the sphere pushes beyond the zone (widen discretisation.active_zone_contact_radii, or switch "
                      "it off)")
         raise InstabilityError(f"unstable run {where}: {cause}{_particle_report(s, c, index)}")
@@ -561,9 +560,9 @@ def _growth_limit_note(what: str, radii: float, axis_name: str, limit_m: float) 
 
 
 def _left_zone(s: State, c: Constants, x: float) -> bool:
-    """Whether x lies on the grid but outside the active zone's slabs (``ActiveZone.check_lo_m``/``hi``)."""
-    z = s.zone
-    return c.grid_lo[0] <= x <= c.grid_hi[0] and not (z.check_lo_m[0] <= x <= z.check_hi_m[0])
+    """Whether x lies on the grid but outside the active zone's slabs (its ranges' ``check_lo``/``check_hi``)."""
+    z = s.zone.ranges
+    return c.grid_lo[0] <= x <= c.grid_hi[0] and not (z.check_lo[0] <= x <= z.check_hi[0])
 
 
 def _particle_report(s: State, c: Constants, index: int) -> str:

@@ -51,11 +51,12 @@ import math
 import numpy as np
 from numba import njit, prange
 
+from plough.mpm.bundles import StressState
 from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
 from plough.mpm.grid import FIXED, GHOST, MIRROR
-from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_node, stencil_offset, stencil_row
+from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row, stencil_row_weight
 
-# per-chunk accumulators written by g2p_update
+# per-chunk accumulators written by g2p_update (ACC_ELASTIC by elastic_energies, on the steps that need it)
 ACC_PLASTIC_WORK = 0
 ACC_KINETIC = 1
 ACC_ELASTIC = 2
@@ -86,7 +87,8 @@ def p2g(P, G, dt, Z):
     n = p_hi - p_lo
     n_chunks = G.buf.shape[0]
     ny, nz = G.shape[1], G.shape[2]
-    inv_dx = 1.0 / G.dx
+    dx = G.dx
+    inv_dx = 1.0 / dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
         buf = G.buf[c]
@@ -94,31 +96,44 @@ def p2g(P, G, dt, Z):
         for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             m = mass[p]
             k_stress = -dt * vol0[p] * J[p] * dinv
-            s = stress[p]
+            # the stress in locals: the grid stores below may alias the stress array as far as the compiler
+            # knows, and would make it reload them at every node
+            s0, s1, s2, s3, s4, s5 = stress[p, 0], stress[p, 1], stress[p, 2], stress[p, 3], stress[p, 4], stress[p, 5]
             # affine momentum matrix Q = m C - dt V D^-1 sigma
-            q00 = m * C[p, 0, 0] + k_stress * s[0]
-            q11 = m * C[p, 1, 1] + k_stress * s[1]
-            q22 = m * C[p, 2, 2] + k_stress * s[2]
-            q12 = m * C[p, 1, 2] + k_stress * s[3]
-            q21 = m * C[p, 2, 1] + k_stress * s[3]
-            q02 = m * C[p, 0, 2] + k_stress * s[4]
-            q20 = m * C[p, 2, 0] + k_stress * s[4]
-            q01 = m * C[p, 0, 1] + k_stress * s[5]
-            q10 = m * C[p, 1, 0] + k_stress * s[5]
+            q00 = m * C[p, 0, 0] + k_stress * s0
+            q11 = m * C[p, 1, 1] + k_stress * s1
+            q22 = m * C[p, 2, 2] + k_stress * s2
+            q12 = m * C[p, 1, 2] + k_stress * s3
+            q21 = m * C[p, 2, 1] + k_stress * s3
+            q02 = m * C[p, 0, 2] + k_stress * s4
+            q20 = m * C[p, 2, 0] + k_stress * s4
+            q01 = m * C[p, 0, 1] + k_stress * s5
+            q10 = m * C[p, 1, 0] + k_stress * s5
             mv0, mv1, mv2 = m * v[p, 0], m * v[p, 1], m * v[p, 2]
             st = stencil(x, p, G.origin, inv_dx)
+            # the x and y parts of each sum are taken once per (a, b) row of three nodes, in the order the sums
+            # are written in (w = (wx wy) wz, (mv + q d0 + q d1) + q d2): the same round-off as per node
             for a in range(3):
                 for b in range(3):
+                    row, wab, d0, d1 = stencil_row_weight(st, a, b, ny, nz, dx)
+                    r1 = mv0 + q00 * d0 + q01 * d1
+                    r2 = mv1 + q10 * d0 + q11 * d1
+                    r3 = mv2 + q20 * d0 + q21 * d1
+                    f1 = s0 * d0 + s5 * d1
+                    f2 = s5 * d0 + s1 * d1
+                    f3 = s4 * d0 + s3 * d1
                     for cc in range(3):
-                        node, w = stencil_node(st, a, b, cc, ny, nz)
-                        d0, d1, d2 = stencil_offset(st, a, b, cc, G.dx)
+                        w = wab * st.wz[cc]
+                        d2 = stencil_axis_offset(st, 2, cc, dx)
+                        wk = w * k_stress
+                        node = row + cc
                         buf[node, 0] += w * m
-                        buf[node, 1] += w * (mv0 + q00 * d0 + q01 * d1 + q02 * d2)
-                        buf[node, 2] += w * (mv1 + q10 * d0 + q11 * d1 + q12 * d2)
-                        buf[node, 3] += w * (mv2 + q20 * d0 + q21 * d1 + q22 * d2)
-                        buf[node, 4] += w * k_stress * (s[0] * d0 + s[5] * d1 + s[4] * d2)
-                        buf[node, 5] += w * k_stress * (s[5] * d0 + s[1] * d1 + s[3] * d2)
-                        buf[node, 6] += w * k_stress * (s[4] * d0 + s[3] * d1 + s[2] * d2)
+                        buf[node, 1] += w * (r1 + q02 * d2)
+                        buf[node, 2] += w * (r2 + q12 * d2)
+                        buf[node, 3] += w * (r3 + q22 * d2)
+                        buf[node, 4] += wk * (f1 + s4 * d2)
+                        buf[node, 5] += wk * (f2 + s3 * d2)
+                        buf[node, 6] += wk * (f3 + s2 * d2)
 
 
 @njit(cache=True, inline="always")
@@ -269,7 +284,8 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
     n = p_hi - p_lo
     n_chunks = G.buf.shape[0]
     ny, nz = G.shape[1], G.shape[2]
-    inv_dx = 1.0 / G.dx
+    dx = G.dx
+    inv_dx = 1.0 / dx
     dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
     for c in prange(n_chunks):
         buf = G.buf[c]
@@ -292,20 +308,26 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
             b20 = 0.0
             b21 = 0.0
             b22 = 0.0
+            # x and y parts of each node's weight and offset taken once per (a, b) row: w = (wx wy) wz as per node
             for a in range(3):
                 for b in range(3):
+                    row, wab, d0, d1 = stencil_row_weight(st, a, b, ny, nz, dx)
                     for cc in range(3):
-                        node, w = stencil_node(st, a, b, cc, ny, nz)
-                        d0, d1, d2 = stencil_offset(st, a, b, cc, G.dx)
-                        gv0 = w * grid_v[node, 0]
-                        gv1 = w * grid_v[node, 1]
-                        gv2 = w * grid_v[node, 2]
+                        w = wab * st.wz[cc]
+                        d2 = stencil_axis_offset(st, 2, cc, dx)
+                        node = row + cc
+                        g0 = grid_v[node, 0]
+                        g1 = grid_v[node, 1]
+                        g2 = grid_v[node, 2]
+                        gv0 = w * g0
+                        gv1 = w * g1
+                        gv2 = w * g2
                         v0 += gv0
                         v1 += gv1
                         v2 += gv2
-                        dv0 += w * (grid_v[node, 0] - grid_v[node, 3])
-                        dv1 += w * (grid_v[node, 1] - grid_v[node, 4])
-                        dv2 += w * (grid_v[node, 2] - grid_v[node, 5])
+                        dv0 += w * (g0 - grid_v[node, 3])
+                        dv1 += w * (g1 - grid_v[node, 4])
+                        dv2 += w * (g2 - grid_v[node, 5])
                         b00 += gv0 * d0
                         b01 += gv0 * d1
                         b02 += gv0 * d2
@@ -336,10 +358,11 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
                 wt = wm * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2])
                 for a in range(3):
                     for b in range(3):
+                        row, wab, _, _ = stencil_row_weight(st, a, b, ny, nz, dx)
                         for cc in range(3):
-                            node, w = stencil_node(st, a, b, cc, ny, nz)
-                            buf[node, 0] += w * wm
-                            buf[node, 1] += w * wt
+                            w = wab * st.wz[cc]
+                            buf[row + cc, 0] += w * wm
+                            buf[row + cc, 1] += w * wt
 
 
 @njit(cache=True, parallel=True)
@@ -354,7 +377,7 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     they follow C (G.div and L_buf are not read). Writes P.x (x += dt v_grid), J, stress, eps_p,
     temperature, sigma_y0 and deps_last (the flow stress at rest and the last plastic increment,
     updated where the particle flowed), P.near (1 if within S.near_dist of the sphere surface), and
-    per-chunk accumulators acc[c, :] (plastic work, kinetic and elastic energy, adiabatic heat,
+    per-chunk accumulators acc[c, :] (plastic work, kinetic energy, adiabatic heat,
     deepest penetration of a particle centre into the sphere, worst instability code and the particle
     showing it; a particle outside [Z.check_lo, Z.check_hi] has left the grid). Each particle writes
     only its own entries, chunk c only acc[c] and L_buf[c]: race-free.
@@ -367,7 +390,8 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     contiguous slab per chunk (the earlier split, whose slab ends could lie one particle off).
     """
     x, v, C, stress, J, vol0, mass, near = P.x, P.v, P.C, P.stress, P.J, P.vol0, P.mass, P.near
-    mat_a, mat_b, frac_a, table, taylor_quinney = P.mat_a, P.mat_b, P.frac_a, M.table, M.taylor_quinney
+    taylor_quinney = M.taylor_quinney
+    SP = StressState(P.stress, P.J, P.eps_p, P.temperature, P.sigma_y0, P.deps_last, P.mat_a, P.mat_b, P.frac_a)
     sphere_c, sphere_r, grid_lo, grid_hi = S.centre, S.radius, Z.check_lo, Z.check_hi
     p_lo, p_hi = Z.p_lo, Z.p_hi
     n_chunks = acc.shape[0]
@@ -377,7 +401,6 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
     for c in prange(n_chunks):
         wp_sum = 0.0
         ke_sum = 0.0
-        el_sum = 0.0
         heat_sum = 0.0
         pen_max = -1e300
         bad = BAD_NONE
@@ -391,12 +414,10 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
                     _with_dilatation(Cp, _gather_scalar(G.div, x, p, G.origin, inv_dx, ny, nz), L)
                 J_new = J[p] * _det_i_plus(dt, L)
                 J[p] = J_new
-                deps, w_pl = update_stress(P, p, L, dt, M)
+                deps, w_pl = update_stress(SP, p, L, dt, M)  # the stress fields only: a cheaper call
                 vol = vol0[p] * J_new
                 wp_sum += w_pl * vol
                 heat_sum += taylor_quinney * w_pl * vol
-                K, G_shear = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
-                el_sum += elastic_energy_density(stress, p, K, G_shear) * vol
                 ke_sum += 0.5 * mass[p] * (v[p, 0] * v[p, 0] + v[p, 1] * v[p, 1] + v[p, 2] * v[p, 2])
                 x0 = x[p, 0] + dt * v_grid[p, 0]
                 x1 = x[p, 1] + dt * v_grid[p, 1]
@@ -425,7 +446,6 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
                     bad_p = p
         acc[c, ACC_PLASTIC_WORK] = wp_sum
         acc[c, ACC_KINETIC] = ke_sum
-        acc[c, ACC_ELASTIC] = el_sum
         acc[c, ACC_HEAT] = heat_sum
         acc[c, ACC_PENETRATION] = pen_max
         acc[c, ACC_BAD] = bad
@@ -470,6 +490,30 @@ def _det_i_plus(dt, L):
     return a00 * (a11 * a22 - a12 * a21) - a01 * (a10 * a22 - a12 * a20) + a02 * (a10 * a21 - a11 * a20)
 
 
+@njit(cache=True, parallel=True)
+def elastic_energies(P, table, Z, acc, block):
+    """The elastic energy of the active particles, per chunk, as ``g2p_update`` deals them.
+
+    Reads P.stress, P.vol0, P.J and the materials (P.mat_a, mat_b, frac_a, rows of the packed ``table``) of
+    the particles Z.p_lo <= p < Z.p_hi; writes acc[c, ACC_ELASTIC] = sum of s:s / (4 G) + p^2 / (2 K) times
+    the volume over chunk c's blocks of ``block`` particles (the split of ``g2p_update``, so the sum over the
+    chunks is the one it would give). Only the recorded steps need it (the run's energy account), so it is not
+    part of the step. Chunk c writes only acc[c]: race-free.
+    """
+    stress, J, vol0, mat_a, mat_b, frac_a = P.stress, P.J, P.vol0, P.mat_a, P.mat_b, P.frac_a
+    p_lo, p_hi = Z.p_lo, Z.p_hi
+    n_chunks = acc.shape[0]
+    n_blocks = (p_hi - p_lo + block - 1) // block
+    for c in prange(n_chunks):
+        el_sum = 0.0
+        for blk in range(c, n_blocks, n_chunks):
+            for p in range(p_lo + blk * block, min(p_lo + (blk + 1) * block, p_hi)):
+                vol = vol0[p] * J[p]
+                K, G_shear = mixed_moduli(table[mat_a[p]], table[mat_b[p]], frac_a[p])
+                el_sum += elastic_energy_density(stress, p, K, G_shear) * vol
+        acc[c, ACC_ELASTIC] = el_sum
+
+
 @njit(cache=True)
 def freeze_particles(P, v_grid, table, p_from, p_to):
     """Freeze the particles p_from <= p < p_to as the active zone leaves them behind.
@@ -498,5 +542,7 @@ def allocate_grid_buffers(n_chunks: int, n_nodes: int) -> np.ndarray:
 
 
 def allocate_velocity_gradient_scratch(n_chunks: int) -> np.ndarray:
-    """Per-chunk 3 x 3 scratch for the projected velocity gradient L_bar in ``g2p_update``."""
-    return np.zeros((n_chunks, 3, 3))
+    """Per-chunk 3 x 3 scratch for the projected velocity gradient L_bar in ``g2p_update``, each chunk's on cache
+    lines of its own: a (n_chunks, 3, 3) view of a padded array, 256 bytes from one chunk's to the next. Packed
+    (72 bytes each), two threads writing their scratch for every particle shared a cache line."""
+    return np.zeros((n_chunks, 4, 8))[:, :3, :3]
