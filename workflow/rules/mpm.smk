@@ -9,7 +9,7 @@
 # does: no source file is an input, so neither a figure's code nor a file's time reruns a run, and
 # run files copied into another checkout of the same solver are reused. The run script's own code
 # (comments and docstrings aside) is a param too.
-# numba compiles the kernels into __pycache__ on first use; parallel first compilations of cache=True
+# numba compiles the kernels on first use into a cache folder named by the solver's fingerprint (plough.mpm); parallel first compilations of cache=True
 # functions can race, so the first job of a new solver compiles them while the others wait on a lock
 # (workflow/scripts/mpm_run.py); no job depends on a warm-up file, which a copy would lack.
 # A gated finest run (plough.study.skipping: a sweep point's finest size under mpm.skip_finest_tolerance) is
