@@ -7,7 +7,8 @@ reader checks a run file against its run with it (plough.study.runfiles).
 numba compiles the kernels into its cache on first use, and parallel first compilations of
 ``cache=True`` functions can race on the cache files: the first job that finds the kernels' sources
 changed (results/.numba_warm records their times and sizes, numba's own cache key, with numba's and
-Python's versions) compiles them with a tiny scene while the other jobs wait on a lock.
+Python's versions and the cache folder, named by the solver's fingerprint: plough.mpm) compiles them
+with a tiny scene while the other jobs wait on a lock.
 
 Whether a gated finest run is needed at all is decided before it is scheduled (workflow/scripts/mpm_refine.py,
 the checkpoint mpm_refine); this job only runs.
@@ -42,7 +43,8 @@ def warm_numba(log) -> None:
     """Compile numba's kernels unless this source state is already compiled; one job at a time."""
     stamp = Path(smk.output[0]).parents[1] / ".numba_warm"  # results/.numba_warm
     key = json.dumps({"sources": [(str(p), p.stat().st_mtime_ns, p.stat().st_size) for p in solver_files()],
-                      "numba": numba.__version__, "python": sys.version, "executable": sys.executable})
+                      "numba": numba.__version__, "python": sys.version, "executable": sys.executable,
+                      "cache": numba.config.CACHE_DIR})
     stamp.parent.mkdir(parents=True, exist_ok=True)
     with open(stamp.with_name(".numba_warm.lock"), "a") as lock:
         fcntl.flock(lock, fcntl.LOCK_EX)  # released when the file closes, or the process dies
