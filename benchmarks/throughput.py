@@ -83,13 +83,14 @@ def measure(scene_file: Path, h_um: float, block: str, steps: int, threads: int,
     for _ in range(WARM_SLIDE_STEPS):
         solver.step(state, const)
     setup_s = time.perf_counter() - t0
-    zone = getattr(state, "zone", None)
-    zone = getattr(zone, "ranges", zone)  # the zone's ranges: on the zone itself in earlier trees
     worked = 0
     timed = 0
     t0 = time.perf_counter()
     while timed < steps and state.sphere.phase == "slide":
         solver.step(state, const)
+        # the zone's ranges after this step (a new tuple each step in this tree; on the zone itself in earlier ones)
+        zone = getattr(state, "zone", None)
+        zone = getattr(zone, "ranges", zone)
         worked += (zone.p_hi - zone.p_lo) if zone is not None else state.particles.n
         timed += 1
     seconds = time.perf_counter() - t0
