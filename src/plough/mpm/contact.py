@@ -76,6 +76,16 @@ C_AREA = 9
 N_CBUF = 12
 
 
+@njit(cache=True, inline="always")
+def face_offset(P, p, centre):
+    """Particle p's offset from the sphere's centre (q0, q1, q2), its distance and its edge e = V_p^(1/3): the
+    gap of its face to the sphere is dist - radius - e / 2. Reads P.x, vol0, J of particle p."""
+    q0 = P.x[p, 0] - centre[0]
+    q1 = P.x[p, 1] - centre[1]
+    q2 = P.x[p, 2] - centre[2]
+    return q0, q1, q2, math.sqrt(q0 * q0 + q1 * q1 + q2 * q2), (P.vol0[p] * P.J[p]) ** (1.0 / 3.0)
+
+
 @njit(cache=True)
 def _inside_box(origin, dx, shape, centre, radius):
     """Index ranges of the grid nodes that can lie inside the sphere."""
@@ -117,12 +127,10 @@ def scatter_contact_stress(P, G, S, Z, ray_local=False):
     for p in range(Z.p_lo, Z.p_hi):
         if near[p] == 0:
             continue
-        q0 = x[p, 0] - centre[0]
-        q1 = x[p, 1] - centre[1]
-        q2 = x[p, 2] - centre[2]
+        q0, q1, q2, dist, e = face_offset(P, p, centre)
         vol = P.vol0[p] * P.J[p]
         # proximity dx - gap of the particle's face to the sphere surface (> 0 within one cell)
-        prox = dx - (math.sqrt(q0 * q0 + q1 * q1 + q2 * q2) - radius - 0.5 * vol ** (1.0 / 3.0))
+        prox = dx - (dist - radius - 0.5 * e)
         kappa = P.sigma_y0[p] / SQRT3
         st = stencil(x, p, origin, inv_dx)
         dwx, dwy, dwz = bspline2_grad(st.g[0])[1:], bspline2_grad(st.g[1])[1:], bspline2_grad(st.g[2])[1:]
@@ -416,11 +424,7 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
     for p in range(Z.p_lo, Z.p_hi):
         if near[p] == 0:
             continue
-        q0 = x[p, 0] - centre[0]
-        q1 = x[p, 1] - centre[1]
-        q2 = x[p, 2] - centre[2]
-        dist = math.sqrt(q0 * q0 + q1 * q1 + q2 * q2)
-        e = (P.vol0[p] * P.J[p]) ** (1.0 / 3.0)
+        q0, q1, q2, dist, e = face_offset(P, p, centre)
         g = dist - radius - 0.5 * e
         if g >= dx or dist <= 0.0:
             continue
