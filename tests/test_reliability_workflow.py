@@ -231,7 +231,9 @@ def _dataset_script(tmp_path: Path, figure: str, paths: dict[str, Path]) -> Path
     params = _Namespace(mpm=SMOKE["mpm"], power_law=SMOKE["power_law"], runs={r: str(p) for r, p in paths.items()},
                         view=runfiles.figure_view(SMOKE, figure))
     smk = _Namespace(params=params, config=SMOKE, output=[str(out)], log=[str(log)],
-                     wildcards=_Namespace(figure=figure), input=_Namespace(runs=[str(p) for p in paths.values()]))
+                     wildcards=_Namespace(figure=figure),
+                     # the smoke config gates no finest run: no refinement decisions (checkpoint mpm_refine)
+                     input=_Namespace(runs=[str(p) for p in paths.values()], decisions=[]))
     runpy.run_path(str(ROOT / "workflow/scripts/mpm_dataset.py"), init_globals={"snakemake": smk})
     return out
 
