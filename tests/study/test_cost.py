@@ -25,6 +25,22 @@ def test_particle_estimate_follows_the_seeding(example, graded):
     assert estimate(scene).particles == pytest.approx(state.particles.n, rel=0.03)
 
 
+@pytest.mark.parametrize("example", ["uncoated_rigid_plastic", "zinc_coated_steel"])
+def test_memory_request_counts_the_solver_grid_and_its_thread_copies(example):
+    """The request holds the grid the solver allocates (with the per-thread P2G copies of the cluster's
+    8 threads) besides the particles: a graded block with a shallow fine zone has far fewer particles on the
+    same grid."""
+    scene = Scene.from_yaml(ROOT / "examples" / f"{example}.yaml").with_sized_domain()
+    scene = replace(scene, discretisation=replace(scene.discretisation, graded=True, fine_zone_depth_particles=6.0))
+    state, const = solver.init(scene, n_chunks=8)
+    est = estimate(scene)
+    assert est.grid_nodes == const.grid.n_nodes
+    grid_bytes = sum(a.nbytes for a in (state.work.grid_buf, state.work.grid_m, state.work.grid_v,
+                                        state.work.grid_div, state.work.cbuf, state.work.last_push, state.work.flags))
+    particle_bytes = sum(a.nbytes for a in state.particles if hasattr(a, "nbytes"))
+    assert est.memory_mb * 1e6 >= 600e6 + grid_bytes + particle_bytes
+
+
 def test_active_fraction_of_simple_runs():
     # a zone wider than the block covers all of it
     assert active_fraction(0.5, 0.2, 1.0, 2.0, 100, 100) == 1.0

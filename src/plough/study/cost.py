@@ -17,14 +17,21 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from plough.mpm.grid import make_grid
 from plough.mpm.particles import particle_count_ratio, uniform_particle_count
 from plough.mpm.scene import Scene
 
-#: Bytes per particle (state arrays) plus the grid share at 2 particles per cell and 2 threads,
-#: rounded up; measured peak RSS is below this for the reference scene. The state is about 250 B
-#: per particle and the grid about 30 B per uniform particle, so graded runs (at most 2x fewer
-#: particles on the same grid) still fit.
+#: Bytes per particle: the state (about 250 B) and the scratch, rounded up; with the grid of a uniform
+#: run at 2 particles per cell and 2 threads the measured peak RSS of the reference scene is below it.
 BYTES_PER_PARTICLE = 400
+#: Bytes a grid node holds besides the per-thread P2G copies (plough.mpm.solver.Work: mass, 6 velocities,
+#: dilatation, 12 contact sums, last push, flags), and per thread (the P2G copy: 7 float64 channels).
+#: Counted apart because graded runs with a shallow fine zone have 0.2-0.25 of the uniform particle count on
+#: the same grid, and a cluster job's 8 threads multiply the copies.
+GRID_BYTES_PER_NODE = 169
+GRID_BYTES_PER_NODE_PER_THREAD = 56
+#: the threads a memory request allows for: the cluster profile's 8 (this machine runs 2)
+REQUEST_THREADS = 8
 BASE_MEMORY_MB = 600  # interpreter, numba, xarray
 SETTLE_STEPS = 300
 
@@ -34,6 +41,7 @@ class RunCost:
     particles: int
     steps: int
     active_fraction: float = 1.0  # mean share of the particles a step works on
+    grid_nodes: int = 0  # the grid's nodes at the start (it may grow mid-run: not counted)
 
     @property
     def particle_steps(self) -> float:
@@ -42,7 +50,8 @@ class RunCost:
 
     @property
     def memory_mb(self) -> int:
-        return int(BASE_MEMORY_MB + self.particles * BYTES_PER_PARTICLE / 1e6)
+        grid = self.grid_nodes * (GRID_BYTES_PER_NODE + REQUEST_THREADS * GRID_BYTES_PER_NODE_PER_THREAD)
+        return int(BASE_MEMORY_MB + (self.particles * BYTES_PER_PARTICLE + grid) / 1e6)
 
 
 def wave_speed_m_s(scene: Scene) -> float:
@@ -68,7 +77,10 @@ def estimate(scene: Scene) -> RunCost:
     if half_width is not None:
         fraction = active_fraction(scene.start_x_m, scene.sliding.distance_m, dom.length_m, half_width,
                                    press + SETTLE_STEPS, slide)
-    return RunCost(particles=particles, steps=int(press + SETTLE_STEPS + slide), active_fraction=fraction)
+    grid = make_grid(dom.length_m, dom.radius_m, dom.symmetric, scene.discretisation.cell_size_m,
+                     scene.grid_headroom_m)
+    return RunCost(particles=particles, steps=int(press + SETTLE_STEPS + slide), active_fraction=fraction,
+                   grid_nodes=grid.n_nodes)
 
 
 def active_fraction(start_m: float, slide_m: float, length_m: float, half_width_m: float, steps_in_place: float,
