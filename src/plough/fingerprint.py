@@ -4,7 +4,7 @@ A run is identified by its scene and by the solver that computed it. The solver 
 :mod:`plough.mpm` (the scene, the kernels, the run loop, the result's measurements) and
 :mod:`plough.materials` (flow laws, named materials, interfaces): the import closure of
 ``plough.mpm.run`` less :mod:`plough.io` and the package's ``__init__``, which write provenance (version,
-commit) and files, never a number of the result.
+commit) and files, never a number of the result, and less the verification set-ups (``NOT_SOLVER``).
 
 Each module is hashed by its syntax tree with the docstrings removed, printed back as source
 (:func:`ast.unparse`): comments, docstrings, blank lines and formatting do not change what the solver
@@ -25,6 +25,9 @@ from pathlib import Path
 PACKAGE = Path(__file__).resolve().parent
 #: The solver's modules, relative to the plough package (a folder means every module in it).
 SOLVER_PARTS = ("mpm", "materials.py")
+#: Modules inside those parts that no run's result depends on: the verification set-ups (Hertz, Tabor)
+#: that tests and benchmarks build their scenes with (no kernel in them); editing one reruns nothing.
+NOT_SOLVER = ("mpm/indentation.py",)
 #: Hex digits kept: 64 bits, far beyond any chance collision between two versions of the solver.
 DIGITS = 16
 
@@ -59,7 +62,7 @@ def solver_files(package: Path = PACKAGE) -> list[Path]:
     for part in SOLVER_PARTS:
         p = package / part
         files.extend(sorted(p.glob("*.py")) if p.is_dir() else [p])
-    return files
+    return [f for f in files if f.relative_to(package).as_posix() not in NOT_SOLVER]
 
 
 @cache
