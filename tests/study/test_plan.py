@@ -111,12 +111,20 @@ def test_the_plan_states_the_range_refinement_only_where_needed_leaves(tmp_path)
     config = copy.deepcopy(SMOKE)
     assert make_plan(config, directory=tmp_path).gated == {}  # off: every run counted, no range
     config["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
-    gated = sorted(matrix.skippable_runs(config))
+    coarser = matrix.skippable_runs(config)
+    gated = sorted(coarser)
     needed, not_needed = gated[:2], gated[2:4]
     (tmp_path / "results" / "refinement").mkdir(parents=True)
+
+    def decision(rid: str, tolerance: dict[str, float]) -> str:
+        return json.dumps({"run_finest": rid in needed, "coarser_runs": list(coarser[rid]), "tolerance": tolerance})
+
     for rid in needed + not_needed:
-        (tmp_path / "results" / "refinement" / f"{rid}.json").write_text(json.dumps({"run_finest": rid in needed}))
+        (tmp_path / "results" / "refinement" / f"{rid}.json").write_text(decision(rid, {"mu": 0.05, "dp": 0.3}))
     (tmp_path / "results" / "refinement" / f"{gated[4]}.json").write_text("{not json")  # unreadable: undecided
+    # made under another tolerance: undecided until the workflow redoes it
+    assert len(gated) > 5
+    (tmp_path / "results" / "refinement" / f"{gated[5]}.json").write_text(decision(gated[5], {"mu": 0.1, "dp": 0.3}))
     plan = make_plan(config, directory=tmp_path)
     assert plan.gated == {rid: True if rid in needed else False if rid in not_needed else None for rid in gated}
     every = list(plan.runs)

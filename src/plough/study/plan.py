@@ -256,18 +256,27 @@ def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path =
         runs[rid] = RunPlan(rid, family, h, c.particle_steps, c.memory_mb, here, here * threads / cluster,
                             cost.runtime_minutes(c, cluster))
     figures = {fig: [r for r in matrix.figure_runs(config, fig) if r in runs] for fig in ALL_FIGURES}
+    tolerance = config["mpm"].get("skip_finest_tolerance")
     return Plan(config, threads, cores, cluster, rates, measured, runs, figures,
-                decisions(directory, matrix.skippable_runs(config)))
+                decisions(directory, matrix.skippable_runs(config), tolerance))
 
 
-def decisions(directory: Path, gated: Iterable[str]) -> dict[str, bool | None]:
+def decisions(directory: Path, gated: Mapping[str, tuple[str, str]],
+              tolerance: Any = None) -> dict[str, bool | None]:
     """gated finest run -> its refinement decision under ``directory`` (``results/refinement/<run>.json``:
-    True needed, False not), None where none is made (or it cannot be read)."""
+    True needed, False not), None where none is made, it cannot be read, or it was made from other coarser
+    runs or under another tolerance than ``tolerance`` (``mpm.skip_finest_tolerance``; the workflow redoes
+    such a decision before it counts)."""
+    from plough.study.skipping import tolerances
+
+    wanted = tolerances(tolerance) if tolerance is not None else None
     out: dict[str, bool | None] = {}
-    for rid in gated:
+    for rid, coarser in gated.items():
         path = directory / DECISIONS / f"{rid}.json"
         try:
-            out[rid] = bool(json.loads(path.read_text())["run_finest"])
+            made = json.loads(path.read_text())
+            current = list(made["coarser_runs"]) == list(coarser) and (wanted is None or made["tolerance"] == wanted)
+            out[rid] = bool(made["run_finest"]) if current else None
         except (OSError, ValueError, KeyError, TypeError):
             out[rid] = None
     return out
