@@ -19,10 +19,10 @@ import math
 import numpy as np
 import pytest
 
-from plough.materials import rigid_plastic
+from plough.materials import DX56, ZINC_BULK, ZINC_COATING, rigid_plastic
 from plough.mpm import transfers as tr
 from plough.mpm.bundles import MaterialData, SphereData, grid_of, whole
-from plough.mpm.constitutive import I_G, I_K, pack_materials, rest_flow_stresses
+from plough.mpm.constitutive import I_G, I_K, pack_materials, rest_flow_stresses, update_stress
 from plough.mpm.grid import FIXED, FREE, GHOST, MIRROR, Grid, boundary_flags, make_grid, mirror_plane_index
 from plough.mpm.particles import particles_of
 
@@ -371,6 +371,49 @@ def test_g2p_update_blocks_cover_every_particle_once():
         acc, got = run(n_chunks, block, first, last)
         for a, b in zip(got, ref, strict=True):
             np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("n_chunks", [1, 2])
+def test_g2p_update_stores_what_the_stress_update_of_each_particle_stores(n_chunks):
+    """g2p_update's inlined stress update against ``update_stress`` called particle by particle, to the bit.
+
+    Every field the stress update writes (stress, J, eps_p, temperature, sigma_y0, deps_last) for the four flow
+    laws' kin (DX56, bulk zinc, the coating, mixed particles), most particles flowing. Fails on a build whose stores
+    inside the prange body are dropped (numba drops stores into an array taken from a named tuple there)."""
+    rng, x, v, vol0, J0, mass = random_particles(n=240, seed=21)
+    n = x.shape[0]
+    table = pack_materials([DX56, ZINC_BULK, ZINC_COATING])
+    mat_a, mat_b = rng.integers(0, 3, n).astype(np.int32), rng.integers(0, 3, n).astype(np.int32)
+    frac_a = rng.choice([0.0, 1.0, 0.3, 0.8], n)
+    C = rng.normal(0.0, 2e4, (n, 3, 3))
+    dt = 1e-7
+    M = MaterialData(table, 50.0, 0.9)
+
+    def state():
+        eps_p = rng.uniform(0.0, 0.3, n)
+        temperature = rng.uniform(298.0, 400.0, n)
+        sigma_y0 = np.zeros(n)
+        rest_flow_stresses(eps_p, temperature, mat_a, mat_b, frac_a, table, sigma_y0)
+        return particles_of(n, x=x.copy(), v=v, C=C, stress=random_sym_stress(rng, n), J=J0.copy(), vol0=vol0,
+                            mass=mass, eps_p=eps_p, temperature=temperature, sigma_y0=sigma_y0,
+                            deps_last=rng.uniform(0.0, 1e-3, n), mat_a=mat_a, mat_b=mat_b, frac_a=frac_a)
+
+    P = state()
+    fields = ("stress", "J", "eps_p", "temperature", "sigma_y0", "deps_last")
+    P_ref = P._replace(**{f: getattr(P, f).copy() for f in fields})
+    eps0 = P.eps_p.copy()
+    G, Z = grid_of(ORIGIN, DX, SHAPE, n_chunks), whole(n, SHAPE)
+    acc = np.zeros((n_chunks, tr.N_ACC))
+    tr.g2p_update(P, G, M, SphereData(np.ones(3), np.zeros(3), DX, DX), Z, dt, 0, np.zeros((n, 3)),
+                  tr.allocate_velocity_gradient_scratch(n_chunks), acc, 5)
+    for p in range(n):  # project 0: L = C; J first, as g2p_update does
+        P_ref.J[p] = P_ref.J[p] * tr._det_i_plus(dt, C[p])
+        update_stress(P_ref, p, C[p], dt, M)
+    flowed = P_ref.eps_p > eps0
+    assert n // 2 < flowed.sum() < n  # most flow, some stay elastic
+    assert len(set(zip(mat_a[flowed], mat_b[flowed], frac_a[flowed], strict=True))) > 9  # every law, mixed ones
+    for f in fields:
+        np.testing.assert_array_equal(getattr(P, f), getattr(P_ref, f), err_msg=f)
 
 
 def test_p2g_zeroes_stale_buffer():

@@ -64,6 +64,8 @@ __all__ = [
     "return_map",
     "return_map_at_rest",
     "non_softening",
+    "plastic_flow",
+    "stress_update",
     "update_stress",
     "update_stresses",
 ]
@@ -472,6 +474,33 @@ def return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p, dt, rate_scale, 
 
 # ----------------------------------------------------------------------------- stress update
 @njit(cache=True)
+def plastic_flow(P, p, q_trial, G, dt, M):
+    """The return map of particle ``p``'s plastic trial state (``q_trial`` > ``P.sigma_y0[p]``) and its flow.
+
+    Reads ``P.eps_p[p]``, ``temperature[p]``, ``sigma_y0[p]``, ``deps_last[p]``, the materials (``P.mat_a[p]``,
+    ``mat_b[p]``, ``frac_a[p]``, rows of ``M.table``), ``M.rate_scale``, ``M.taylor_quinney``, the shear modulus
+    ``G`` and ``dt``. If it flowed (deps_p > 0) writes ``P.eps_p[p] += deps_p``, ``P.temperature[p] +=
+    taylor_quinney sigma_y deps_p / (rho cp)``, ``P.sigma_y0[p]`` at the new state and ``P.deps_last[p] = deps_p``.
+    Returns ``(deps_p, sigma_y)`` (:func:`return_map_at_rest`). Part of :func:`stress_update`, a call of its own:
+    only plastic trial states come here, and its stores must not be inlined into a ``prange`` body (see there).
+    """
+    eps_p, temperature, sigma_y0, deps_last = P.eps_p, P.temperature, P.sigma_y0, P.deps_last
+    prm_a, prm_b, frac_a = M.table[P.mat_a[p]], M.table[P.mat_b[p]], P.frac_a[p]
+    T = temperature[p]
+    deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, M.rate_scale, T, sigma_y0[p],
+                                        deps_last[p])
+    if deps > 0.0:
+        w = sig_y * deps
+        eps_p[p] += deps
+        fb = 1.0 - frac_a
+        rho_cp = frac_a * prm_a[I_RHO] * prm_a[I_CP] + fb * prm_b[I_RHO] * prm_b[I_CP]
+        temperature[p] = T + M.taylor_quinney * w / rho_cp
+        sigma_y0[p] = mixed_flow_stress(prm_a, prm_b, frac_a, eps_p[p], 0.0, temperature[p])
+        deps_last[p] = deps
+    return deps, sig_y
+
+
+@njit(cache=True)
 def update_stress(P, p, L, dt, M):
     """Advance the Cauchy stress of particle ``p`` by one step (eqs. 6.1 and 6.2).
 
@@ -500,9 +529,22 @@ def update_stress(P, p, L, dt, M):
     Returns ``(deps_p, w)``: the plastic strain increment and the plastic work density
     w = sigma_y deps_p (J/m^3 of current volume).
     """
-    stress, eps_p, temperature, sigma_y0, deps_last = P.stress, P.eps_p, P.temperature, P.sigma_y0, P.deps_last
+    return stress_update(P.stress, P, p, L, dt, M)
+
+
+@njit(cache=True, inline="always")
+def stress_update(stress, P, p, L, dt, M):
+    """:func:`update_stress` with the stress array ``stress`` (= ``P.stress``) handed in apart, inlined in its caller.
+
+    Why apart: numba's parallel dead-code elimination drops a store into an array taken from a named tuple inside a
+    ``prange`` body when the body does not read that array again (the tuple is immutable, so its fields are not
+    counted as aliases of the arguments; numba issues 7135, 10338). Inlined into ``g2p_update`` with the stress
+    written through ``P.stress``, the new stress and ``deps_last`` were never stored. Here the one store of the
+    inlined part goes to ``stress``, which the caller takes from its bundle outside the ``prange``; the stores of
+    a flowing particle are made by :func:`plastic_flow`, a call of its own (no inlining, so nothing of it can be
+    dropped). Same reads, writes, operations and order as :func:`update_stress` documents.
+    """
     prm_a, prm_b, frac_a, J = M.table[P.mat_a[p]], M.table[P.mat_b[p]], P.frac_a[p], P.J[p]
-    rate_scale, taylor_quinney = M.rate_scale, M.taylor_quinney
     K, G = mixed_moduli(prm_a, prm_b, frac_a)
 
     # deviatoric part of the old stress
@@ -566,11 +608,9 @@ def update_stress(P, p, L, dt, M):
     q_trial = math.sqrt(
         1.5 * (n11 * n11 + n22 * n22 + n33 * n33 + 2.0 * (n23 * n23 + n13 * n13 + n12 * n12))
     )
-    T = temperature[p]
-    deps, sig_y = 0.0, sigma_y0[p]
+    deps, sig_y = 0.0, P.sigma_y0[p]
     if q_trial > sig_y:  # only a plastic trial state calls the return map (an elastic one would return these)
-        deps, sig_y, _ = return_map_at_rest(prm_a, prm_b, frac_a, q_trial, G, eps_p[p], dt, rate_scale, T, sig_y,
-                                            deps_last[p])
+        deps, sig_y = plastic_flow(P, p, q_trial, G, dt, M)
     w = 0.0
     if deps > 0.0:
         scale = sig_y / q_trial
@@ -581,12 +621,6 @@ def update_stress(P, p, L, dt, M):
         n13 *= scale
         n12 *= scale
         w = sig_y * deps
-        eps_p[p] += deps
-        fb = 1.0 - frac_a
-        rho_cp = frac_a * prm_a[I_RHO] * prm_a[I_CP] + fb * prm_b[I_RHO] * prm_b[I_CP]
-        temperature[p] = T + taylor_quinney * w / rho_cp
-        sigma_y0[p] = mixed_flow_stress(prm_a, prm_b, frac_a, eps_p[p], 0.0, temperature[p])
-        deps_last[p] = deps
 
     minus_p = K * (J - 1.0)  # -p, with p = -K (J - 1)
     stress[p, 0] = n11 + minus_p

@@ -52,7 +52,7 @@ import numpy as np
 from numba import njit, prange
 
 from plough.mpm.bundles import StressState
-from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, update_stress
+from plough.mpm.constitutive import elastic_energy_density, mixed_moduli, stress_update
 from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import APIC_D_INV_FACTOR, stencil, stencil_axis_offset, stencil_row, stencil_row_weight
 
@@ -414,7 +414,9 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
                     _with_dilatation(Cp, _gather_scalar(G.div, x, p, G.origin, inv_dx, ny, nz), L)
                 J_new = J[p] * _det_i_plus(dt, L)
                 J[p] = J_new
-                deps, w_pl = update_stress(SP, p, L, dt, M)  # the stress fields only: a cheaper call
+                # inlined; the stress array is handed in from outside the prange (a store through SP.stress in
+                # the prange body would be dropped: constitutive.stress_update says why)
+                deps, w_pl = stress_update(stress, SP, p, L, dt, M)
                 vol = vol0[p] * J_new
                 wp_sum += w_pl * vol
                 heat_sum += taylor_quinney * w_pl * vol
