@@ -71,9 +71,12 @@ class ContactLaw(NamedTuple):
 
 class StressState(NamedTuple):
     """The particle fields the stress update reads and writes (``SP``, ``constitutive.update_stress``), a subset of
-    ``P``'s: ``g2p_update`` passes this to the update of each particle instead of ``P``, because a bundle is passed
-    by value (each array's pointer, shape and strides), and the nine arrays cost the call less than all of ``P``'s
-    (g2p_update on one thread, 10% less time on an elastic block: docs/journal/2026-12-02-throughput.md)."""
+    ``P``'s: ``g2p_update`` hands this to the stress update (``constitutive.stress_update``, inlined) and so to
+    ``constitutive.plastic_flow``, a call made for each plastic trial state: a bundle is passed by value (each
+    array's pointer, shape and strides), and the nine arrays cost a call less than all of ``P``'s (g2p_update on
+    one thread, 10% less time on an elastic block before the inlining: docs/journal/2026-12-02-throughput.md).
+    Inside a ``prange`` body an array of a bundle is only read: numba may drop a store into it
+    (``constitutive.stress_update`` says why)."""
 
     stress: np.ndarray  # (n, 6) Voigt xx, yy, zz, yz, xz, xy, Pa
     J: np.ndarray  # (n,) det F

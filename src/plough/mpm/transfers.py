@@ -42,6 +42,10 @@ by construction: chunk c writes only its own grid copy ``G.buf[c]``; the grid up
 copies node by node (each node owned by one iteration). The gathers read the grid and write only
 particle p's own entries; the dilatation scatter inside ``g2p_kinematics`` writes only its
 chunk's ``G.buf[c]`` and ``g2p_update`` only its chunk's scratch ``L_buf[c]``.
+
+Stores inside a ``prange`` body go to arrays taken from the bundles before the ``prange`` (or read again in
+the body): numba's parallel dead-code elimination drops a store into an array taken from a named tuple inside
+the body that the body does not read again (numba issues 7135, 10338; ``constitutive.stress_update``).
 """
 
 from __future__ import annotations
