@@ -456,6 +456,19 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
                         wts[k, s] = w
                         inv_meff[k] += w * w / grid_m[t]
                     s += 1
+    # in contact: the particles the sphere holds back, i.e. whose face would cross it in this step at the
+    # velocity they had before any contact impulse (their neighbours' impulses may then stop them, so a
+    # particle's own impulse is no measure), or did so within the hold
+    touch = np.zeros(nk, dtype=np.bool_)
+    for k in range(nk):
+        if inv_meff[k] <= 0.0:
+            continue
+        u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
+        vn = (u0 - vs[0]) * nrm[k, 0] + (u1 - vs[1]) * nrm[k, 1] + (u2 - vs[2]) * nrm[k, 2]
+        p = idx[k]
+        if vn < -max(gap[k], 0.0) / dt:
+            last_push_p[p] = step
+        touch[k] = step - last_push_p[p] <= law.hold_steps
     lam = np.zeros(nk)
     acc_n = np.zeros(5)
     for _sweep in range(law.sweeps):
@@ -470,28 +483,29 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
                 lam[k] = new
                 _apply_impulse(G, S, nodes, ysign, wts, k, d * nrm[k, 0], d * nrm[k, 1], d * nrm[k, 2], acc_n)
     acc_t = np.zeros(5)
-    pushed = 0
+    touching = 0
     area_xy = 0.0
     for k in range(nk):
         p = idx[k]
-        n0, n1, n2 = nrm[k, 0], nrm[k, 1], nrm[k, 2]
-        area = size[k] * size[k] / (abs(n0) + abs(n1) + abs(n2))
-        if lam[k] > 0.0:
-            last_push_p[p] = step
-            pushed += 1
-            if n2 < 0.0:
-                area_xy += area * (-n2)
-        elif step - last_push_p[p] > law.hold_steps or inv_meff[k] <= 0.0:
+        if inv_meff[k] <= 0.0:
             continue
+        n0, n1, n2 = nrm[k, 0], nrm[k, 1], nrm[k, 2]
+        u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
+        r0, r1, r2 = u0 - vs[0], u1 - vs[1], u2 - vs[2]
+        vn = r0 * n0 + r1 * n1 + r2 * n2
+        # or its face ends the step within the resolved gap of the sphere
+        if not touch[k] and gap[k] + vn * dt > size[k] * size[k] / (2.0 * radius):
+            continue
+        area = size[k] * size[k] / (abs(n0) + abs(n1) + abs(n2))
+        touching += 1
+        if n2 < 0.0:
+            area_xy += area * (-n2)
         sg = P.stress[p]
         pressure = -(n0 * n0 * sg[0] + n1 * n1 * sg[1] + n2 * n2 * sg[2]
                      + 2.0 * (n1 * n2 * sg[3] + n0 * n2 * sg[4] + n0 * n1 * sg[5]))
         tau = interface_shear(law.model, law.params, pressure, P.sigma_y0[p] / SQRT3)
         if tau <= 0.0:
             continue
-        u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
-        r0, r1, r2 = u0 - vs[0], u1 - vs[1], u2 - vs[2]
-        vn = r0 * n0 + r1 * n1 + r2 * n2
         t0, t1, t2 = r0 - vn * n0, r1 - vn * n1, r2 - vn * n2
         vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
         if vt <= 0.0:
@@ -504,5 +518,5 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
     out[OUT_WORK] = acc_n[3] + acc_t[3]
     out[OUT_IMPACT] = acc_n[3] - acc_n[4]
     out[OUT_DISSIPATION] = acc_t[3] - acc_t[4]
-    out[OUT_NODES] = pushed
+    out[OUT_NODES] = touching
     out[OUT_AREA_XY] = area_xy
