@@ -17,6 +17,7 @@ Run the pieces separately (each merges its rows into the one results file, keyed
     python benchmarks/contact_candidates.py hertz --sizes-um 10 5 --depths-um 2 8
     python benchmarks/contact_candidates.py tabor --sizes-um 10 --depths-um 8
     python benchmarks/contact_candidates.py plough --scene uncoated coated --f 0 --sizes-um 10
+    python benchmarks/contact_candidates.py plough --scene uncoated coated --f 0.5 1 --sizes-um 20 10
 """
 
 from __future__ import annotations
@@ -114,11 +115,14 @@ def plough(args) -> list[dict]:
                     ds = simulate(scene, progress=False, threads=args.threads)
                     wall = time.perf_counter() - t0
                     work = float(ds.external_work[-1])
+                    n_rec = len(ds.contact_area_xy)  # the contact's own area, mean over the second half
                     parts = sum(float(ds[k][-1]) for k in ENERGY_PARTS)
                     row = {"case": f"plough:{name}:f{f:g}:h{h:g}", "contact": mode, "scene": name, "f": f,
                            "h_um": h, **{q: float(ds[q]) for q in common.RESULTS},
                            "analytical_mu": float(ana.mu), "analytical_mu_pl": float(ana.mu_pl),
-                           "analytical_dp_um": float(ana.dp) * 1e6,
+                           "analytical_dp_um": float(ana.dp) * 1e6, "analytical_mu_sh": float(ana.mu_sh),
+                           "analytical_Axy_um2": float(ana.Axy) * 1e12,
+                           "contact_area_xy_um2": float(ds.contact_area_xy[n_rec // 2:].mean()) * 1e12,
                            "mu_error": float(ds.mu) / float(ana.mu) - 1.0,
                            "energy_parts_over_work": parts / work if work > 0 else float("nan"),
                            "closest_centre_h": -float(ds.max_particle_penetration) / (h * 1e-6),
@@ -126,6 +130,9 @@ def plough(args) -> list[dict]:
                            "particles": int(ds.attrs["cost_particles"])}
                     print(f"plough {name} f={f:g} h={h:g} {mode:8s} mu={row['mu']:.4f} (analytical "
                           f"{row['analytical_mu']:.4f}, err {row['mu_error']:+.3f}) mu_pl={row['mu_pl']:.4f} "
+                          f"(ana {row['analytical_mu_pl']:.4f}) mu_sh={row['mu_sh']:.4f} (ana "
+                          f"{row['analytical_mu_sh']:.4f}) area_xy={row['contact_area_xy_um2']:.0f} um2 (ana Axy "
+                          f"{row['analytical_Axy_um2']:.0f}) "
                           f"dp={row['dp'] * 1e6:.2f} um (ana {row['analytical_dp_um']:.2f}) energy "
                           f"{row['energy_parts_over_work']:.3f} closest={row['closest_centre_h']:.3f} h "
                           f"wall={wall:.1f}s", flush=True)

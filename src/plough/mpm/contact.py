@@ -53,6 +53,7 @@ from numba import njit
 
 from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import bspline2_grad, stencil, stencil_node
+from plough.mpm.transfers import _mirror_partner
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
 SQRT3 = math.sqrt(3.0)
@@ -84,6 +85,13 @@ def face_offset(P, p, centre):
     q1 = P.x[p, 1] - centre[1]
     q2 = P.x[p, 2] - centre[2]
     return q0, q1, q2, math.sqrt(q0 * q0 + q1 * q1 + q2 * q2), (P.vol0[p] * P.J[p]) ** (1.0 / 3.0)
+
+
+@njit(cache=True, inline="always")
+def normal_pressure(n0, n1, n2, s0, s1, s2, s3, s4, s5):
+    """The normal traction -n . sigma . n (Pa, > 0 in compression) of the Voigt stress (xx, yy, zz, yz, xz, xy)
+    on the plane of unit normal n."""
+    return -(n0 * n0 * s0 + n1 * n1 * s1 + n2 * n2 * s2 + 2.0 * (n1 * n2 * s3 + n0 * n2 * s4 + n0 * n1 * s5))
 
 
 @njit(cache=True)
@@ -274,8 +282,7 @@ def sphere_contact(G, S, law, step, dt, out):
                 vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
                 if cw > 0.0:
                     inv = 1.0 / cw
-                    pressure = -(n0 * n0 * s0 + n1 * n1 * s1 + n2 * n2 * s2
-                                 + 2.0 * (n1 * n2 * s3 + n0 * n2 * s4 + n0 * n1 * s5)) * inv
+                    pressure = normal_pressure(n0, n1, n2, s0, s1, s2, s3, s4, s5) * inv
                     kappa = kap * inv
                 else:
                     pressure = 0.0
@@ -314,14 +321,12 @@ def sphere_contact(G, S, law, step, dt, out):
 
 # ----------------------------------------------------------------------------- contact on the particles
 @njit(cache=True, inline="always")
-def _fold(t, j, mirror_j0, ny, nz):
-    """The node that holds node t's velocity (t itself, or across the mirror plane for a ghost at j < mirror_j0)
-    and the sign of its y component there (-1 if the partner lies off the grid)."""
+def _fold(node, j, mirror_j0, ny, nz):
+    """The node that holds node's velocity (itself, or its partner across the mirror plane for a ghost at
+    j < mirror_j0, ``transfers._mirror_partner``: -1 off the grid) and the sign of its y component there."""
     if mirror_j0 >= 0 and j < mirror_j0:
-        if 2 * mirror_j0 - j >= ny:
-            return -1, 1.0
-        return t + (2 * (mirror_j0 - j)) * nz, -1.0
-    return t, 1.0
+        return _mirror_partner(node, ny, nz, mirror_j0), -1.0
+    return node, 1.0
 
 
 @njit(cache=True)
@@ -385,11 +390,18 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
     accumulated; a later sweep may lower one). Only particles whose face meets the sphere act, so the
     footprint is the sphere's to within a particle, not a cell wider (``sphere_contact``).
 
-    Interface shear: a particle pushed at ``step``, or within ``law.hold_steps`` steps (its
-    ``last_push_p``), gets a tangential impulse against its slip, J_t <= min(tau A_p dt, m_eff |u_t|)
-    (it never reverses the slip), with A_p = e_p^2 / (|n_x| + |n_y| + |n_z|), the area per particle of a
-    cubic lattice's face cut by a plane of normal n, tau from ``interface_shear`` with kappa = sigma_y0 / sqrt 3
-    and the pressure -n . sigma . n of the particle itself; one Gauss-Seidel pass after the normal ones.
+    Interface shear acts on every particle in contact, pushed or not: one the sphere holds back (its face would
+    cross the sphere in this step at the velocity it had before any contact impulse) at ``step`` or within
+    ``law.hold_steps`` steps (its ``last_push_p``), or whose face ends the step within e_p^2 / (2 R) of the sphere
+    (the sag of the sphere one particle size from its lowest point: the gap a flat face's particles show under
+    it, which the particles' spacing does not resolve). Its own impulse is no measure of contact: touching
+    particles share nodes, so a few impulses stop their neighbours too, and in steady sliding most particles
+    against the sphere get none (mu_sh 0.05 against the analytical 0.19 on the tiny f = 1 scene,
+    docs/journal/2026-12-02-particle-contact-shear.md). Each gets a tangential impulse against its slip,
+    J_t <= min(tau A_p dt, m_eff |u_t|) (it never reverses the slip), with A_p = e_p^2 / (|n_x| + |n_y| + |n_z|),
+    the area per particle of a cubic lattice's face cut by a plane of normal n, tau from ``interface_shear`` with
+    kappa = sigma_y0 / sqrt 3 and the pressure -n . sigma . n of the particle itself; one pass after the normal
+    sweeps.
 
     Reads P.x, vol0, J, stress, sigma_y0, near of the active particles Z.p_lo <= p < Z.p_hi; G.m, G.flags, the
     grid geometry and the zone's free x range (Z.i_free_lo..i_free_hi: nodes beyond it, FIXED nodes and
@@ -397,7 +409,7 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
     last_push_p[p] and out[0:N_OUT]: the forces on the sphere are minus the momentum given to the nodes
     (/ dt), OUT_WORK the sphere's work (that momentum . v_sphere), OUT_IMPACT and OUT_DISSIPATION the work of
     the normal and tangential impulses less the nodes' kinetic energy gain (so the contact's energy account
-    closes exactly), OUT_NODES the number of particles pushed, OUT_AREA_XY their sum A_p |n_z| (n_z < 0).
+    closes exactly), OUT_NODES the number of particles in contact, OUT_AREA_XY their sum A_p |n_z| (n_z < 0).
     Mirror plane (G.mirror_j0 >= 0): a stencil node at y < 0 is the ghost of its partner at -y, whose
     velocity it reads and whose velocity takes the impulse with y reversed; a node on the plane keeps v_y = 0
     (it holds the half body's mass and takes the half body's impulse). Serial: few particles are near the
@@ -456,6 +468,19 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
                         wts[k, s] = w
                         inv_meff[k] += w * w / grid_m[t]
                     s += 1
+    # in contact: the particles the sphere holds back, i.e. whose face would cross it in this step at the
+    # velocity they had before any contact impulse (their neighbours' impulses may then stop them, so a
+    # particle's own impulse is no measure), or did so within the hold
+    touch = np.zeros(nk, dtype=np.bool_)
+    for k in range(nk):
+        if inv_meff[k] <= 0.0:
+            continue
+        u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
+        vn = (u0 - vs[0]) * nrm[k, 0] + (u1 - vs[1]) * nrm[k, 1] + (u2 - vs[2]) * nrm[k, 2]
+        p = idx[k]
+        if vn < -max(gap[k], 0.0) / dt:
+            last_push_p[p] = step
+        touch[k] = step - last_push_p[p] <= law.hold_steps
     lam = np.zeros(nk)
     acc_n = np.zeros(5)
     for _sweep in range(law.sweeps):
@@ -470,28 +495,28 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
                 lam[k] = new
                 _apply_impulse(G, S, nodes, ysign, wts, k, d * nrm[k, 0], d * nrm[k, 1], d * nrm[k, 2], acc_n)
     acc_t = np.zeros(5)
-    pushed = 0
+    touching = 0
     area_xy = 0.0
     for k in range(nk):
         p = idx[k]
+        if inv_meff[k] <= 0.0:
+            continue
         n0, n1, n2 = nrm[k, 0], nrm[k, 1], nrm[k, 2]
-        area = size[k] * size[k] / (abs(n0) + abs(n1) + abs(n2))
-        if lam[k] > 0.0:
-            last_push_p[p] = step
-            pushed += 1
-            if n2 < 0.0:
-                area_xy += area * (-n2)
-        elif step - last_push_p[p] > law.hold_steps or inv_meff[k] <= 0.0:
-            continue
-        sg = P.stress[p]
-        pressure = -(n0 * n0 * sg[0] + n1 * n1 * sg[1] + n2 * n2 * sg[2]
-                     + 2.0 * (n1 * n2 * sg[3] + n0 * n2 * sg[4] + n0 * n1 * sg[5]))
-        tau = interface_shear(law.model, law.params, pressure, P.sigma_y0[p] / SQRT3)
-        if tau <= 0.0:
-            continue
         u0, u1, u2 = _particle_velocity(G, nodes, ysign, wts, k)
         r0, r1, r2 = u0 - vs[0], u1 - vs[1], u2 - vs[2]
         vn = r0 * n0 + r1 * n1 + r2 * n2
+        # or its face ends the step within the resolved gap of the sphere
+        if not touch[k] and gap[k] + vn * dt > size[k] * size[k] / (2.0 * radius):
+            continue
+        area = size[k] * size[k] / (abs(n0) + abs(n1) + abs(n2))
+        touching += 1
+        if n2 < 0.0:
+            area_xy += area * (-n2)
+        sg = P.stress[p]
+        pressure = normal_pressure(n0, n1, n2, sg[0], sg[1], sg[2], sg[3], sg[4], sg[5])
+        tau = interface_shear(law.model, law.params, pressure, P.sigma_y0[p] / SQRT3)
+        if tau <= 0.0:
+            continue
         t0, t1, t2 = r0 - vn * n0, r1 - vn * n1, r2 - vn * n2
         vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
         if vt <= 0.0:
@@ -504,5 +529,5 @@ def particle_contact(P, G, S, Z, law, step, dt, last_push_p, out):
     out[OUT_WORK] = acc_n[3] + acc_t[3]
     out[OUT_IMPACT] = acc_n[3] - acc_n[4]
     out[OUT_DISSIPATION] = acc_t[3] - acc_t[4]
-    out[OUT_NODES] = pushed
+    out[OUT_NODES] = touching
     out[OUT_AREA_XY] = area_xy
