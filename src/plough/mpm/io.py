@@ -55,6 +55,32 @@ SERIES_META = {
     "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),
     "time": ("s", "simulated time"),
 }
+#: the grid contact's split of its interface shear (contact.OUT_SH_AREA on; interval means like the forces, full
+#: body; 0 with the particle contact): a region is in front of the sphere's centre in x or behind it (rear), and
+#: below the original surface or above it (_up: pile-up, prow)
+_REGIONS = {"front": "in front of the centre, below the original surface", "rear": "behind the centre, below it",
+            "front_up": "in front of the centre, above the original surface",
+            "rear_up": "behind the centre, above the original surface"}
+_KINDS = {"stuck": "whose slip the impulse stopped (not traction-limited)",
+          "carried": "arriving with a slip under half the sliding speed (carried with the sphere)",
+          "outside": "outside the sphere (within a cell of its surface)",
+          "gap": "whose closest particle face lies more than a quarter cell from the sphere",
+          "lateral": "on the sides (|n_y| > |n_x|)"}
+CONTACT_SPLIT_META = {
+    "contact_shear_area": ("m2", "contact area carrying interface shear: sum of the contact nodes' surface shares"),
+    "contact_shear_capacity": ("N", "sum of tau A over the contact nodes (the interface shear they could carry)"),
+    **{f"contact_area_{r}": ("m2", f"contact nodes' surface shares {text}") for r, text in _REGIONS.items()},
+    **{f"contact_fx_sh_{r}": ("N", f"friction force from interface shear on the contact nodes {text}")
+       for r, text in _REGIONS.items()},
+    **{f"contact_area_xy_{r}": ("m2", f"contact area projected on the sliding plane {text}")
+       for r, text in _REGIONS.items()},
+    **{f"contact_fz_pl_{r}": ("N", f"normal force from normal traction on the contact nodes {text}")
+       for r, text in _REGIONS.items()},
+    **{name: meta for k, text in _KINDS.items()
+       for name, meta in ((f"contact_area_{k}", ("m2", f"surface shares of the contact nodes {text}")),
+                          (f"contact_fx_sh_{k}", ("N", f"friction force from interface shear on the nodes {text}")))},
+}
+SERIES_META.update(CONTACT_SPLIT_META)
 STEADY_META = {
     "mu": ("1", "friction coefficient, mean Fx / mean Fz over the steady window"),
     "mu_pl": ("1", "ploughing part of the friction coefficient"),
