@@ -17,8 +17,10 @@ def derived(r: dict) -> dict:
     axy_front = r["contact_area_xy_front"] + r["contact_area_xy_front_up"]
     d = {"mu_sh": r["Fx_sh"] / fz, "mu_sh_ana": r["analytical_mu_sh"], "A_um2": a * 1e12,
          "Axy_ana_um2": r["analytical_Axy"] * 1e12, "Axy_front_um2": axy_front * 1e12,
-         "Axy_all_um2": r["contact_area_xy"] * 1e12, "tau_over_fkappa": tau / (r["f"] * kappa),
-         "efficiency": r["Fx_sh"] / r["contact_shear_capacity"],  # F_sh / sum tau A: direction and stuck nodes
+         "Axy_all_um2": r["contact_area_xy"] * 1e12,
+         "tau_over_fkappa": tau / (r["f"] * kappa) if r["f"] > 0 else float("nan"),
+         # F_sh / sum tau A: the slip's direction and stuck nodes
+         "efficiency": r["Fx_sh"] / r["contact_shear_capacity"] if r["f"] > 0 else float("nan"),
          # the paper's reading on the MPM's own contact: F_sh = tau x the front half's projection
          "mu_sh_paper_own": tau * axy_front / fz,
          "mu_sh_tauA": tau * a / fz,  # every node traction-limited along x
