@@ -42,10 +42,16 @@ def main() -> None:
         d = derived(r)
         head = f"{r['scene']} f={r['f']:g} h={r['h_um']:g}"
         if md:
-            print(f"| {r['scene']} | {r['f']:g} | {r['h_um']:g} | {r['mu']:.3f} | {d['mu_sh']:.3f} | "
-                  f"{d['mu_sh_ana']:.3f} | {d['A_um2']:.0f} | {d['Axy_front_um2']:.0f} | {d['Axy_ana_um2']:.0f} | "
-                  + " | ".join(f"{d[f'mu_sh_{g}']:.3f}" for g in REGIONS) + f" | {d['tau_over_fkappa']:.2f} | "
-                  f"{d['efficiency']:.2f} | {d['mu_sh_paper_own']:.3f} |")
+            rear = d["mu_sh_rear"] + d["mu_sh_rear_up"]
+            up = d["mu_sh_front_up"] + d["mu_sh_rear_up"]
+            mu_paper = r["mu_pl"] + d["mu_sh_paper_own"]
+            print(f"| {r['scene']} | {r['f']:g} | {r['h_um']:g} | {r['mu']:.3f} | {d['mu_sh']:.3f} "
+                  f"({d['mu_sh_ana']:.3f}) | {d['A_um2'] / d['Axy_ana_um2']:.2f} | "
+                  f"{d['Axy_front_um2'] / d['Axy_ana_um2']:.2f} | {d['hardness_front'] / 1e6:.0f} | "
+                  f"{d['efficiency']:.2f} | {d['tau_over_fkappa']:.2f} | {rear:.3f} | {up:.3f} | "
+                  f"{d['A_carried']:.2f} | {d['A_outside']:.2f} | {d['A_stuck']:.2f} | "
+                  f"{d['mu_sh_paper_own']:.3f} | {mu_paper:.3f} ({r['analytical_mu']:.3f}) | "
+                  f"{r['depth'] * 1e6:.1f} | {int(r['steady'])} |")
             continue
         print(f"{head}: mu {r['mu']:.3f} mu_sh {d['mu_sh']:.3f} (ana {d['mu_sh_ana']:.3f}) Fz {r['Fz']:.2f} N "
               f"depth {r['depth'] * 1e6:.1f} um dp {r['dp'] * 1e6:.1f} um steady {r['steady']:.0f}")
