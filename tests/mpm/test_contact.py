@@ -549,3 +549,45 @@ def test_ray_local_proximity_is_the_stencils_for_the_particles_on_the_nodes_ray(
     np.testing.assert_array_equal(local[:, others], full[:, others])
     assert np.all(local[:, 8] <= full[:, 8])
     assert np.any(local[:, 8] < full[:, 8]) and np.any((local[:, 8] == full[:, 8]) & (full[:, 8] > 0))
+
+
+# ----------------------------------------------------------------------------- the shear split (diagnostics)
+@pytest.mark.parametrize("model,iparams", MODELS)
+@pytest.mark.parametrize("ci", range(len(CENTRES)))
+def test_shear_split_adds_up_and_matches_the_nodes(model, iparams, ci):
+    """The diagnostic channels (OUT_SH_AREA on): the regions' areas, shear forces, projected areas and normal
+    forces add up to the totals, and each region, the stuck and the outside nodes match a classification made
+    here from the nodal data (front: n_x > 0; up: the sphere's surface on the node's ray above z = 0)."""
+    case = make_case(60 + 3 * model + ci, centre=CENTRES[ci])
+    _, contact, n, vn, rel = classify(case)
+    grid_v, _, out = call(case, model, iparams)
+    m, cb, c, r = case["grid_m"], case["cbuf"], case["centre"], case["radius"]
+    area = np.linalg.norm(cb[:, ct.C_AREA:ct.C_AREA + 3], axis=1)
+    t_before = rel - vn[:, None] * n
+    fx = m * (t_before[:, 0] - (grid_v - case["v_sphere"])[:, 0]) / DT  # minus the x impulse, per unit time
+    fz = m * vn * n[:, 2] / DT  # the normal impulse -m vn along n, on the sphere
+    region = np.where(n[:, 0] > 0, ct.REGION_FRONT, ct.REGION_REAR) + 2 * (c[2] + r * n[:, 2] > 0)
+    for reg in range(ct.N_REGIONS):
+        sel = contact & (region == reg)
+        assert out[ct.OUT_REGION_AREA + reg] == pytest.approx(area[sel].sum(), rel=1e-12, abs=1e-30)
+        assert out[ct.OUT_REGION_FX + reg] == pytest.approx(fx[sel].sum(), rel=1e-6, abs=1e-12)
+        xy = sel & (n[:, 2] < 0)
+        assert out[ct.OUT_REGION_AREA_XY + reg] == pytest.approx((area * -n[:, 2])[xy].sum(), rel=1e-12, abs=1e-30)
+        assert out[ct.OUT_REGION_FZ + reg] == pytest.approx(fz[sel].sum(), rel=1e-9, abs=1e-12)
+    regions = slice(0, ct.N_REGIONS)
+    assert out[ct.OUT_REGION_AREA:][regions].sum() == pytest.approx(out[ct.OUT_SH_AREA], rel=1e-12)
+    assert out[ct.OUT_REGION_FX:][regions].sum() == pytest.approx(out[ct.OUT_FT], rel=1e-12, abs=1e-15)
+    assert out[ct.OUT_REGION_AREA_XY:][regions].sum() == pytest.approx(out[ct.OUT_AREA_XY], rel=1e-12)
+    assert out[ct.OUT_REGION_FZ:][regions].sum() == pytest.approx(out[ct.OUT_FN + 2], rel=1e-12)
+    # both halves and both sides of the original surface occur over the two centres
+    assert (out[ct.OUT_REGION_AREA:][regions] > 0).sum() >= 2
+    outside = contact & (np.linalg.norm(NODES - c, axis=1) > r)
+    assert out[ct.OUT_OUTSIDE_AREA] == pytest.approx(area[outside].sum(), rel=1e-12, abs=1e-30)
+    assert out[ct.OUT_OUTSIDE_FX] == pytest.approx(fx[outside].sum(), rel=1e-6, abs=1e-12)
+    # stuck: the slip stopped (the impulse m v_t within the traction bound); every subset within the total
+    assert 0.0 < out[ct.OUT_STUCK_AREA] < out[ct.OUT_SH_AREA]
+    for a, f in ((ct.OUT_STUCK_AREA, ct.OUT_STUCK_FX), (ct.OUT_CARRIED_AREA, ct.OUT_CARRIED_FX),
+                 (ct.OUT_OUTSIDE_AREA, ct.OUT_OUTSIDE_FX), (ct.OUT_GAP_AREA, ct.OUT_GAP_FX),
+                 (ct.OUT_LATERAL_AREA, ct.OUT_LATERAL_FX)):
+        assert 0.0 <= out[a] <= out[ct.OUT_SH_AREA] * (1 + 1e-12)
+        assert abs(out[f]) <= np.abs(fx[contact]).sum() * (1 + 1e-9)

@@ -276,3 +276,17 @@ def test_standard_errors_of_the_window_and_the_sections():
     assert out["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
     # one section: dp's error cannot be estimated and is left out, not written as NaN or 0
     assert "dp_standard_error" not in io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6)
+
+
+def test_contact_summary_of_the_shear_split():
+    """The steady-window summaries: means over the window only, the front pressure over both front regions."""
+    from plough.mpm.io import CONTACT_SPLIT_META, contact_summary
+
+    mask = np.array([False, True, True])
+    series = {k: np.array([1e9, 1.0, 3.0]) for k in CONTACT_SPLIT_META}  # the first record lies outside
+    out = contact_summary(series, mask, fz=4.0)
+    assert out["contact_shear_area_mean"] == 2.0
+    assert out["contact_front_pressure"] == 4.0 / (2.0 + 2.0)
+    assert out["mu_sh_rear"] == (2.0 + 2.0) / 4.0 and out["mu_sh_carried"] == 2.0 / 4.0
+    series = {k: np.zeros(3) for k in CONTACT_SPLIT_META}  # the particle contact writes no split
+    assert np.isnan(contact_summary(series, mask, fz=4.0)["contact_front_pressure"])

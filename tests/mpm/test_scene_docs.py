@@ -258,7 +258,8 @@ def test_every_named_material_and_result_variable_is_on_the_page():
     text = DOC.read_text(encoding="utf-8")
     for name in MATERIALS:
         assert f"| `{name}` |" in text, f"docs/scenes.md: the named material {name!r} is not in the materials table"
-    variables = [*io.SERIES_META, *io.STEADY_META, *io.STANDARD_ERROR_META, *io.STEADINESS_META]
+    variables = [*io.SERIES_META, *io.STEADY_META, *io.STANDARD_ERROR_META, *io.STEADINESS_META,
+                 *io.CONTACT_SUMMARY_META]
     absent = [v for v in variables if f"`{v}`" not in text]
     assert not absent, f"docs/scenes.md: result variables not described: {absent}"
 

@@ -70,7 +70,27 @@ OUT_IMPACT = 7  # kinetic energy lost by the inelastic normal projection, J
 OUT_WORK = 8  # work done by the sphere on the material this step, J
 OUT_NODES = 9  # number of contact nodes
 OUT_AREA_XY = 10  # contact area projected on the xy plane, m^2
-N_OUT = 11
+# diagnostics of the grid contact's interface shear (sphere_contact only; particle_contact leaves them 0;
+# docs/journal/2026-12-02-interface-shear-split.md). Over the nodes in contact (pushed now or held):
+OUT_SH_AREA = 11  # sum of the nodes' surface shares A_i, m^2
+OUT_SH_TAU_AREA = 12  # sum of tau_i A_i (the traction the nodes could carry), N
+#: the regions of a contact node: in front of the centre in x (n_x > 0, the sliding direction) or behind it,
+#: and below or above the original surface z = 0 (where its ray meets the sphere: centre_z + R n_z)
+REGION_FRONT, REGION_REAR, REGION_FRONT_UP, REGION_REAR_UP = 0, 1, 2, 3
+N_REGIONS = 4
+OUT_REGION_AREA = 13  # 13:17 sum A_i by region, m^2
+OUT_REGION_FX = 17  # 17:21 x force on the sphere from tangential impulses by region, N (they add up to OUT_FT)
+OUT_REGION_AREA_XY = 21  # 21:25 sum A_i |n_z| (n_z < 0) by region, m^2 (they add up to OUT_AREA_XY)
+OUT_REGION_FZ = 25  # 25:29 z force on the sphere from normal impulses by region, N (they add up to OUT_FN z)
+#: overlapping subsets of the contact nodes, each an area (m^2) and the x force of its tangential impulses (N):
+OUT_STUCK_AREA, OUT_STUCK_FX = 29, 30  # the slip stopped (m |v_t| <= tau A_i dt: J_t = m v_t, not the traction)
+OUT_CARRIED_AREA, OUT_CARRIED_FX = 31, 32  # arriving slip under half the sphere's speed (material carried along)
+OUT_OUTSIDE_AREA, OUT_OUTSIDE_FX = 33, 34  # the node lies outside the sphere (within a cell of its surface)
+OUT_GAP_AREA, OUT_GAP_FX = 35, 36  # its closest particle face is more than dx / 4 from the sphere
+OUT_LATERAL_AREA, OUT_LATERAL_FX = 37, 38  # on the sides: |n_y| > |n_x|
+N_OUT = 39
+#: the fraction of the sphere's speed under which a node's arriving slip counts as carried with the sphere
+CARRIED_SLIP = 0.5
 #: channels of the contact scratch: 6 stress, kappa, mass weight, proximity dx - gap of the closest particle,
 #: 3 the surface vector sum_p V_p grad N_i (C_AREA: C_AREA + 3)
 C_AREA = 9
@@ -204,6 +224,44 @@ def surface_share(cbuf, node, mirror_plane):
     return math.sqrt(g0 * g0 + g1 * g1 + g2 * g2)
 
 
+@njit(cache=True, inline="always")
+def _record_split(out, S, area, tau, fx, fz, n, vt, stuck, dist, gap, dx):
+    """Add one contact node to the diagnostic channels OUT_SH_AREA..OUT_LATERAL_FX; reads only, so the contact
+    is the same with or without them. ``area``: its surface share A_i; ``tau``: its interface shear strength;
+    ``fx``: the x force of its tangential impulse on the sphere; ``fz``: the z force of its normal impulse;
+    ``n``: the sphere's outward normal at it; ``vt``: its arriving slip speed; ``stuck``: the impulse stopped
+    the slip (J_t = m v_t, not the traction bound); ``dist``: its distance from the centre; ``gap``: of its
+    closest particle face; S the sphere (centre, radius, velocity); dx the cell."""
+    n0, n1, n2 = n
+    out[OUT_SH_AREA] += area
+    out[OUT_SH_TAU_AREA] += tau * area
+    region = REGION_FRONT if n0 > 0.0 else REGION_REAR
+    if S.centre[2] + S.radius * n2 > 0.0:
+        region += 2  # the _UP regions: the sphere's surface on the node's ray lies above the original surface
+    out[OUT_REGION_AREA + region] += area
+    out[OUT_REGION_FX + region] += fx
+    if n2 < 0.0:
+        out[OUT_REGION_AREA_XY + region] += area * (-n2)
+    out[OUT_REGION_FZ + region] += fz
+    if stuck:
+        out[OUT_STUCK_AREA] += area
+        out[OUT_STUCK_FX] += fx
+    vs = S.velocity
+    speed = math.sqrt(vs[0] * vs[0] + vs[1] * vs[1] + vs[2] * vs[2])
+    if speed > 0.0 and vt < CARRIED_SLIP * speed:
+        out[OUT_CARRIED_AREA] += area
+        out[OUT_CARRIED_FX] += fx
+    if dist > S.radius:
+        out[OUT_OUTSIDE_AREA] += area
+        out[OUT_OUTSIDE_FX] += fx
+    if gap > 0.25 * dx:
+        out[OUT_GAP_AREA] += area
+        out[OUT_GAP_FX] += fx
+    if abs(n1) > abs(n0):
+        out[OUT_LATERAL_AREA] += area
+        out[OUT_LATERAL_FX] += fx
+
+
 @njit(cache=True)
 def sphere_contact(G, S, law, step, dt, out):
     """Impose the sphere on the nodes inside it and measure the reaction.
@@ -213,7 +271,8 @@ def sphere_contact(G, S, law, step, dt, out):
     :class:`plough.mpm.bundles.ContactLaw`). Reads and writes the per-node contact memory G.last_push
     (the step a node's velocity was last cut by the normal projection): a node pushed at ``step``, or
     within the last ``law.hold_steps`` steps, is in contact and carries interface shear. Writes G.v of
-    contact nodes and out[0:N_OUT] (see the OUT_* indices). Serial: it visits only the box of nodes
+    contact nodes and out[0:N_OUT] (see the OUT_* indices; OUT_SH_AREA on, the split of the interface shear by
+    region and kind of node, are diagnostics: ``_record_split``). Serial: it visits only the box of nodes
     around the sphere. It works on them whatever the active zone: nodes outside the zone's range have no
     mass and are skipped. A clamped node the sphere pushed would take the sphere's velocity; this is not
     excluded here: behind the sphere it moves away from the material (no push), and ahead the zone's end
@@ -317,6 +376,8 @@ def sphere_contact(G, S, law, step, dt, out):
                 out[OUT_NODES] += 1.0
                 if n2 < 0.0:
                     out[OUT_AREA_XY] += area * (-n2)
+                _record_split(out, S, area, tau, jt * t0 / vt / dt if vt > 0.0 else 0.0, -jn * n2 / dt, (n0, n1, n2),
+                              vt, vt > 0.0 and m * vt <= tau * area * dt, dist, gap, dx)
 
 
 # ----------------------------------------------------------------------------- contact on the particles

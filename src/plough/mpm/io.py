@@ -55,6 +55,50 @@ SERIES_META = {
     "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),
     "time": ("s", "simulated time"),
 }
+#: the grid contact's split of its interface shear (contact.OUT_SH_AREA on; interval means like the forces, full
+#: body; 0 with the particle contact): a region is in front of the sphere's centre in x or behind it (rear), and
+#: below the original surface or above it (_up: pile-up, prow)
+_REGIONS = {"front": "in front of the centre, below the original surface", "rear": "behind the centre, below it",
+            "front_up": "in front of the centre, above the original surface",
+            "rear_up": "behind the centre, above the original surface"}
+_KINDS = {"stuck": "whose slip the impulse stopped (not traction-limited)",
+          "carried": "arriving with a slip under half the sliding speed (carried with the sphere)",
+          "outside": "outside the sphere (within a cell of its surface)",
+          "gap": "whose closest particle face lies more than a quarter cell from the sphere",
+          "lateral": "on the sides (|n_y| > |n_x|)"}
+CONTACT_SPLIT_META = {
+    "contact_shear_area": ("m2", "contact area carrying interface shear: sum of the contact nodes' surface shares"),
+    "contact_shear_capacity": ("N", "sum of tau A over the contact nodes (the interface shear they could carry)"),
+    **{f"contact_area_{r}": ("m2", f"contact nodes' surface shares {text}") for r, text in _REGIONS.items()},
+    **{f"contact_fx_sh_{r}": ("N", f"friction force from interface shear on the contact nodes {text}")
+       for r, text in _REGIONS.items()},
+    **{f"contact_area_xy_{r}": ("m2", f"contact area projected on the sliding plane {text}")
+       for r, text in _REGIONS.items()},
+    **{f"contact_fz_pl_{r}": ("N", f"normal force from normal traction on the contact nodes {text}")
+       for r, text in _REGIONS.items()},
+    **{name: meta for k, text in _KINDS.items()
+       for name, meta in ((f"contact_area_{k}", ("m2", f"surface shares of the contact nodes {text}")),
+                          (f"contact_fx_sh_{k}", ("N", f"friction force from interface shear on the nodes {text}")))},
+}
+SERIES_META.update(CONTACT_SPLIT_META)
+#: steady-window summaries of the shear split (means over the window; written when the series are there)
+CONTACT_SUMMARY_META = {
+    "contact_shear_area_mean": ("m2", "mean contact area carrying interface shear over the steady window"),
+    "contact_front_pressure": ("Pa", "mean Fz over the mean projected area of the contact's front half (the "
+                                     "analytical model's hardness H; nan without the grid contact's series)"),
+    "mu_sh_rear": ("1", "part of mu_sh from the contact behind the sphere's centre"),
+    "mu_sh_carried": ("1", "part of mu_sh from nodes carried with the sphere (arriving slip under half the speed)"),
+}
+
+
+def contact_summary(series: dict[str, np.ndarray], mask: np.ndarray, fz: float) -> dict[str, float]:
+    """The steady-window summaries of the grid contact's shear split (CONTACT_SUMMARY_META)."""
+    mean = {k: float(series[k][mask].mean()) for k in CONTACT_SPLIT_META}
+    front = mean["contact_area_xy_front"] + mean["contact_area_xy_front_up"]
+    return {"contact_shear_area_mean": mean["contact_shear_area"],
+            "contact_front_pressure": fz / front if front > 0.0 else float("nan"),
+            "mu_sh_rear": (mean["contact_fx_sh_rear"] + mean["contact_fx_sh_rear_up"]) / fz,
+            "mu_sh_carried": mean["contact_fx_sh_carried"] / fz}
 STEADY_META = {
     "mu": ("1", "friction coefficient, mean Fx / mean Fz over the steady window"),
     "mu_pl": ("1", "ploughing part of the friction coefficient"),
@@ -381,6 +425,10 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     for name, value in steady.items():
         u, ln = STEADY_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
+    if all(k in series for k in CONTACT_SPLIT_META):
+        for name, value in contact_summary(series, mask, Fz).items():
+            u, ln = CONTACT_SUMMARY_META[name]
+            ds[name] = ((), float(value), {"units": u, "long_name": ln})
     for name, value in standard_errors(series, mask, y, prof, a_exp).items():
         u, ln = STANDARD_ERROR_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})

@@ -24,6 +24,32 @@ from plough.mpm.constitutive import pack_materials
 from plough.mpm.scene import PRESETS, RESOLVED_CONTACT_PARTICLES, Scene, defaults_taken, read_scene_data
 
 
+def _split_channels() -> tuple[list[str], np.ndarray, np.ndarray]:
+    """The series of the grid contact's shear split (io.CONTACT_SPLIT_META), their contact.OUT_* channels and
+    signs (friction forces positive against the sliding, as Fx_sh)."""
+    regions = ("front", "rear", "front_up", "rear_up")
+    chans = {"contact_shear_area": (contact.OUT_SH_AREA, 1.0),
+             "contact_shear_capacity": (contact.OUT_SH_TAU_AREA, 1.0)}
+    for r, name in enumerate(regions):
+        chans[f"contact_area_{name}"] = (contact.OUT_REGION_AREA + r, 1.0)
+        chans[f"contact_fx_sh_{name}"] = (contact.OUT_REGION_FX + r, -1.0)
+        chans[f"contact_area_xy_{name}"] = (contact.OUT_REGION_AREA_XY + r, 1.0)
+        chans[f"contact_fz_pl_{name}"] = (contact.OUT_REGION_FZ + r, 1.0)
+    for kind, (area, fx) in {"stuck": (contact.OUT_STUCK_AREA, contact.OUT_STUCK_FX),
+                             "carried": (contact.OUT_CARRIED_AREA, contact.OUT_CARRIED_FX),
+                             "outside": (contact.OUT_OUTSIDE_AREA, contact.OUT_OUTSIDE_FX),
+                             "gap": (contact.OUT_GAP_AREA, contact.OUT_GAP_FX),
+                             "lateral": (contact.OUT_LATERAL_AREA, contact.OUT_LATERAL_FX)}.items():
+        chans[f"contact_area_{kind}"] = (area, 1.0)
+        chans[f"contact_fx_sh_{kind}"] = (fx, -1.0)
+    assert set(chans) == set(io.CONTACT_SPLIT_META)
+    names = list(io.CONTACT_SPLIT_META)
+    return names, np.array([chans[n][0] for n in names]), np.array([chans[n][1] for n in names])
+
+
+SPLIT_NAMES, SPLIT_CHANNELS, SPLIT_SIGNS = _split_channels()
+
+
 class _Recorder:
     """Interval means of the per-step forces and snapshots of the energies, every ``every`` steps."""
 
@@ -32,6 +58,7 @@ class _Recorder:
         self.rows: list[dict[str, float]] = []
         self.slid: list[float] = []
         self._sum = np.zeros(7)
+        self._split = np.zeros(len(SPLIT_NAMES))
         self._count = 0
         self.max_penetration = -np.inf
 
@@ -42,6 +69,7 @@ class _Recorder:
         fn, ft = k * out[contact.OUT_FN:contact.OUT_FN + 3], k * out[contact.OUT_FT:contact.OUT_FT + 3]
         fy = 0.0 if k == 2.0 else fn[1] + ft[1]
         self._sum += np.array([-(fn[0] + ft[0]), fy, fn[2] + ft[2], -fn[0], -ft[0], fn[2], ft[2]])
+        self._split += k * SPLIT_SIGNS * out[SPLIT_CHANNELS]
         self._count += 1
         pen = float(s.work.acc[:, transfers.ACC_PENETRATION].max())
         self.max_penetration = max(self.max_penetration, pen)
@@ -64,9 +92,11 @@ class _Recorder:
             "interface_dissipation": k * w.interface_dissipation, "contact_impact_loss": k * w.contact_impact_loss,
             "frozen_kinetic_loss": k * s.zone.frozen_kinetic_loss_J,
             "heat": k * w.heat, "time": s.time,
+            **dict(zip(SPLIT_NAMES, (self._split / self._count).tolist(), strict=True)),
         })
         self.slid.append(s.sphere.slid_m if s.sphere.phase in ("slide", "done") else 0.0)
         self._sum[:] = 0.0
+        self._split[:] = 0.0
         self._count = 0
 
     def series(self) -> tuple[dict[str, np.ndarray], np.ndarray]:
