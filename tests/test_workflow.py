@@ -53,16 +53,6 @@ def test_bad_config_fails_before_any_job_naming_the_key(workdir, tmp_path):
     assert "['analytical']['k1']" in text and "minimum of 0" in text
 
 
-def test_full_matrix_dry_run(workdir):
-    out = _snakemake(workdir, "-n")
-    assert out.returncode == 0, out.stderr[-3000:]
-    text = out.stdout + out.stderr
-    for fig in ("fig03", "fig04", "fig22"):
-        assert fig in text
-    # refinement only where needed (config/config.yaml): the decisions are planned, the DAG changes after them
-    assert "checkpoint mpm_refine:" in text and "checkpoint jobs" in text
-
-
 def _job_counts(text: str) -> dict[str, int]:
     """The 'Job stats' table of a Snakemake (dry) run: rule -> number of jobs ({} when nothing is to be done)."""
     lines = text.splitlines()

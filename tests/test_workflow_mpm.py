@@ -100,10 +100,17 @@ def test_smoke_fig15_runs_extrapolates_draws_and_caches(tmp_path):
 
 
 def test_full_matrix_dry_run_schedules_every_run_once(tmp_path):
+    """One dry run of the full matrix (config/config.yaml) for every check of it: the figures, the refinement
+    checkpoint, and each rule's number of jobs."""
     work = _project_copy(tmp_path)
     out = _snakemake(work, "-n", timeout=300)
     assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
-    counts = _job_counts(out.stdout + out.stderr)
+    text = out.stdout + out.stderr
+    for fig in ("fig03", "fig04", "fig22"):
+        assert fig in text
+    # refinement only where needed (config/config.yaml): the decisions are planned, the DAG changes after them
+    assert "checkpoint mpm_refine:" in text and "checkpoint jobs" in text
+    counts = _job_counts(text)
     gated = matrix.skippable_runs(FULL)  # refinement only where needed is on in config/config.yaml
     assert gated and FULL["mpm"]["skip_finest_tolerance"] is not None
     assert counts["mpm_run"] == len(matrix.all_runs(FULL)) - len(gated)  # a gated finest run waits for its decision
