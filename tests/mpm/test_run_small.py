@@ -1070,3 +1070,19 @@ def test_snapshots_closer_than_a_micrometre_keep_their_own_files(tmp_path):
     files = sorted(p.name for p in tmp_path.glob("*.vtp"))
     assert "tiny_final.vtp" in files
     assert len(files) >= 301
+
+
+def test_a_particle_contact_run_writes_no_grid_split_and_no_nan():
+    """The contact_* series and their summaries are the grid contact's; a particle-contact run (whose split
+    channels stay zero) leaves them out rather than writing zeros and a NaN front pressure."""
+    d = scene_dict(sliding={"distance_um": 100, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
+                   domain={"radius_um": 80, "length_um": 300, "symmetric": True})
+    d["discretisation"] = {**d["discretisation"], "contact": "particle"}
+    ds = simulate(Scene.from_dict(d), progress=False, threads=1)
+    from plough.mpm.io import CONTACT_SPLIT_META, CONTACT_SUMMARY_META
+
+    assert not set(ds.variables) & (set(CONTACT_SPLIT_META) | set(CONTACT_SUMMARY_META))
+    for name, var in ds.data_vars.items():
+        if np.issubdtype(var.dtype, np.floating) and not var.attrs.get("allow_missing"):
+            assert np.isfinite(var.values).all(), name
+    assert float(ds.mu_sh) > 0.0

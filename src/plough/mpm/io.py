@@ -92,11 +92,14 @@ CONTACT_SUMMARY_META = {
 
 
 def contact_summary(series: dict[str, np.ndarray], mask: np.ndarray, fz: float) -> dict[str, float]:
-    """The steady-window summaries of the grid contact's shear split (CONTACT_SUMMARY_META)."""
+    """The steady-window summaries of the grid contact's shear split (CONTACT_SUMMARY_META); none (an empty dict)
+    when the window holds no front contact area, so that no summary is written as NaN."""
     mean = {k: float(series[k][mask].mean()) for k in CONTACT_SPLIT_META}
     front = mean["contact_area_xy_front"] + mean["contact_area_xy_front_up"]
+    if not front > 0.0:
+        return {}
     return {"contact_shear_area_mean": mean["contact_shear_area"],
-            "contact_front_pressure": fz / front if front > 0.0 else float("nan"),
+            "contact_front_pressure": fz / front,
             "mu_sh_rear": (mean["contact_fx_sh_rear"] + mean["contact_fx_sh_rear_up"]) / fz,
             "mu_sh_carried": mean["contact_fx_sh_carried"] / fz}
 STEADY_META = {
@@ -390,6 +393,8 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     the steady window and the residual sections then refer to it.
     """
     slid_total = scene.sliding.distance_m if slid_distance_m is None else slid_distance_m
+    if scene.discretisation.contact == "particle":  # the split is the grid contact's: the particle contact has none
+        series = {k: v for k, v in series.items() if k not in CONTACT_SPLIT_META}
     mask = steady_window_mask(slid_m, scene, slid_total)
     if mask.sum() < 3:
         raise ValueError("fewer than 3 records in the steady window; raise outputs.records")
@@ -409,7 +414,8 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         "dp": dg + hpu, "max_particle_penetration": max_penetration,
     }
     ds = xr.Dataset(
-        {name: (("record",), series[name], {"units": u, "long_name": ln}) for name, (u, ln) in SERIES_META.items()},
+        {name: (("record",), series[name], {"units": u, "long_name": ln}) for name, (u, ln) in SERIES_META.items()
+         if name in series},
         coords={"sliding_distance": (("record",), slid_m, {"units": "m", "long_name": "sliding distance"}),
                 "y": (("y",), y, {"units": "m", "long_name": "lateral position across the groove"}),
                 "section_x": (("section",), sections, {"units": "m", "long_name": "x of the residual cross-sections"})},
