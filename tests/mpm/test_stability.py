@@ -60,9 +60,10 @@ def test_bulk_coating_200_um_completes_bounded():
 
 
 def test_soft_coating_h_tilde_0_1_completes_bounded():
-    """H~ = 0.1 (90 MPa on 900 MPa), t = 25 um: the coating is ploughed through (inertia number 0.87)."""
-    s = scene(layers={"coating_thickness_um": 25, "coating": {"rigid_plastic_hardness_MPa": 90},
-                      "substrate": {"rigid_plastic_hardness_MPa": 900}}, sliding={"distance_um": 300})
+    """H~ = 0.1 (90 MPa on 900 MPa), t = 25 um, inertia number 0.79, at 0.5 N: measured mu 0.171, Fz / load 0.981
+    (at 1 N, whose sized block takes 3.3x the time: 0.189, 0.967)."""
+    s = scene(load_N=0.5, layers={"coating_thickness_um": 25, "coating": {"rigid_plastic_hardness_MPa": 90},
+                                  "substrate": {"rigid_plastic_hardness_MPa": 900}}, sliding={"distance_um": 300})
     assert s.inertia_number < 1.0
     assert_bounded(s, energy=False)
 

@@ -53,7 +53,7 @@ from numba import njit
 
 from plough.mpm.grid import FIXED, GHOST, MIRROR
 from plough.mpm.shape import bspline2_grad, stencil, stencil_node
-from plough.mpm.transfers import _mirror_partner
+from plough.mpm.transfers import mirror_partner
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
 SQRT3 = math.sqrt(3.0)
@@ -225,13 +225,13 @@ def surface_share(cbuf, node, mirror_plane):
 
 
 @njit(cache=True, inline="always")
-def _record_split(out, S, area, tau, fx, fz, n, vt, stuck, dist, gap, dx):
+def _record_split(out, S, speed, area, tau, fx, fz, n, vt, stuck, dist, gap, dx):
     """Add one contact node to the diagnostic channels OUT_SH_AREA..OUT_LATERAL_FX; reads only, so the contact
     is the same with or without them. ``area``: its surface share A_i; ``tau``: its interface shear strength;
     ``fx``: the x force of its tangential impulse on the sphere; ``fz``: the z force of its normal impulse;
     ``n``: the sphere's outward normal at it; ``vt``: its arriving slip speed; ``stuck``: the impulse stopped
     the slip (J_t = m v_t, not the traction bound); ``dist``: its distance from the centre; ``gap``: of its
-    closest particle face; S the sphere (centre, radius, velocity); dx the cell."""
+    closest particle face; S the sphere (centre, radius) and ``speed`` its speed; dx the cell."""
     n0, n1, n2 = n
     out[OUT_SH_AREA] += area
     out[OUT_SH_TAU_AREA] += tau * area
@@ -246,8 +246,6 @@ def _record_split(out, S, area, tau, fx, fz, n, vt, stuck, dist, gap, dx):
     if stuck:
         out[OUT_STUCK_AREA] += area
         out[OUT_STUCK_FX] += fx
-    vs = S.velocity
-    speed = math.sqrt(vs[0] * vs[0] + vs[1] * vs[1] + vs[2] * vs[2])
     if speed > 0.0 and vt < CARRIED_SLIP * speed:
         out[OUT_CARRIED_AREA] += area
         out[OUT_CARRIED_FX] += fx
@@ -287,6 +285,7 @@ def sphere_contact(G, S, law, step, dt, out):
         out[k] = 0.0
     i0, i1, j0, j1, k0, k1 = _inside_box(origin, dx, shape, centre, radius + dx)
     r2 = (radius + dx) * (radius + dx)
+    speed = math.sqrt(v_sphere[0] * v_sphere[0] + v_sphere[1] * v_sphere[1] + v_sphere[2] * v_sphere[2])
     for i in range(i0, i1 + 1):
         px = origin[0] + i * dx - centre[0]
         for j in range(j0, j1 + 1):
@@ -364,8 +363,10 @@ def sphere_contact(G, S, law, step, dt, out):
                 out[OUT_FN + 0] -= jn * n0 / dt
                 out[OUT_FN + 1] -= jn * n1 / dt
                 out[OUT_FN + 2] -= jn * n2 / dt
+                fx = 0.0
                 if vt > 0.0:
-                    out[OUT_FT + 0] += jt * t0 / vt / dt
+                    fx = jt * t0 / vt / dt
+                    out[OUT_FT + 0] += fx
                     out[OUT_FT + 1] += jt * t1 / vt / dt
                     out[OUT_FT + 2] += jt * t2 / vt / dt
                 vt_after = scale * vt
@@ -376,7 +377,7 @@ def sphere_contact(G, S, law, step, dt, out):
                 out[OUT_NODES] += 1.0
                 if n2 < 0.0:
                     out[OUT_AREA_XY] += area * (-n2)
-                _record_split(out, S, area, tau, jt * t0 / vt / dt if vt > 0.0 else 0.0, -jn * n2 / dt, (n0, n1, n2),
+                _record_split(out, S, speed, area, tau, fx, -jn * n2 / dt, (n0, n1, n2),
                               vt, vt > 0.0 and m * vt <= tau * area * dt, dist, gap, dx)
 
 
@@ -384,9 +385,9 @@ def sphere_contact(G, S, law, step, dt, out):
 @njit(cache=True, inline="always")
 def _fold(node, j, mirror_j0, ny, nz):
     """The node that holds node's velocity (itself, or its partner across the mirror plane for a ghost at
-    j < mirror_j0, ``transfers._mirror_partner``: -1 off the grid) and the sign of its y component there."""
+    j < mirror_j0, ``transfers.mirror_partner``: -1 off the grid) and the sign of its y component there."""
     if mirror_j0 >= 0 and j < mirror_j0:
-        return _mirror_partner(node, ny, nz, mirror_j0), -1.0
+        return mirror_partner(node, ny, nz, mirror_j0), -1.0
     return node, 1.0
 
 

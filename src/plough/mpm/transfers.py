@@ -147,7 +147,7 @@ def p2g(P, G, dt, Z):
 
 
 @njit(cache=True, inline="always")
-def _mirror_partner(node, ny, nz, mirror_j0):
+def mirror_partner(node, ny, nz, mirror_j0):
     """The node at -y of ``node`` across the mirror plane j = mirror_j0, or -1 (no plane, on it, off the grid)."""
     if mirror_j0 < 0:
         return -1
@@ -196,7 +196,7 @@ def grid_update(G, Z):
             i0 += grid_buf[c, node, 4]
             i1 += grid_buf[c, node, 5]
             i2 += grid_buf[c, node, 6]
-        partner = _mirror_partner(node, ny, nz, mirror_j0)
+        partner = mirror_partner(node, ny, nz, mirror_j0)
         if partner >= 0:
             for c in range(n_chunks):
                 m += grid_buf[c, partner, 0]
@@ -267,7 +267,7 @@ def grid_dilatation(G, Z):
         for c in range(n_chunks):
             m += grid_buf[c, node, 0]
             t += grid_buf[c, node, 1]
-        partner = _mirror_partner(node, ny, nz, mirror_j0)
+        partner = mirror_partner(node, ny, nz, mirror_j0)
         if partner >= 0:
             for c in range(n_chunks):
                 m += grid_buf[c, partner, 0]
