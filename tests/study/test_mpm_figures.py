@@ -336,6 +336,76 @@ def test_thickness_panel_keeps_every_mark_in_view_and_the_key_off_the_marks(run_
     plt.close(fig)
 
 
+def _drawn_figure(figure: str, ds: xr.Dataset, monkeypatch):
+    """The figure ``figure``'s plotter hands to save (what the PNG and PDF are written from)."""
+    from plough.figures import mpm as mpm_figures
+
+    drawn = []
+    monkeypatch.setattr(mpm_figures, "save", lambda fig, outputs: drawn.append(fig))
+    mpm_figures.PLOTTERS[figure](ds, ["unused.png"])
+    assert len(drawn) == 1
+    return drawn[0]
+
+
+def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(run_files, tmp_path, monkeypatch):
+    """Issue 32: at strong interface shear the MPM's mu_sh is not expected to equal the analytical one (the
+    contact grows under shear), its mu_pl is; so Fig. 13 draws mu (a, b), mu_pl (c, d) and mu_sh (e, f), each
+    against H~ (left) and t (right): every panel's trend is its own quantity's h -> 0 values, its dashed lines
+    that quantity's analytical values, its y label and title name it. One key, with the note on mu_sh; Fig. 11
+    keeps its single row of dp."""
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import to_rgb
+
+    from plough.figures import mpm as mpm_figures
+
+    ds = _written(build_dataset(SMOKE, "fig13", run_files), tmp_path)
+    fig = _drawn_figure("fig13", ds, monkeypatch)
+    assert len(fig.axes) == 6
+    series = {"_a": ("interface", "hardness_ratio"), "_b": ("coating", "thickness_um")}
+    for r, quantity in enumerate(("mu", "mu_pl", "mu_sh")):
+        for c, suffix in enumerate(("_a", "_b")):
+            ax = fig.axes[2 * r + c]
+            letter = "abcdef"[2 * r + c]
+            assert ax.get_ylabel() == mpm_figures.QUANTITY[quantity][0]
+            assert ax.get_title().startswith(f"({letter}) {mpm_figures.ROW_TITLES[quantity]} vs "), ax.get_title()
+            assert (ax.get_xlabel() != "") == (r == 2)  # the x axes labelled once, under the last row
+            dim, axis = series[suffix]
+            x = ds[axis].values
+            lines = [line for line in ax.lines if np.asarray(line.get_xdata()).size == x.size]
+            for i, label in enumerate(ds[dim].values):
+                colour = to_rgb(mpm_figures.SERIES_COLOURS[i])  # the two interfaces share the analytical mu_pl
+                for style, name in (("-", f"{quantity}_h0{suffix}"), ("--", f"{quantity}_analytical{suffix}")):
+                    want = ds[name].sel({dim: label}).values
+                    hits = [line for line in lines if line.get_linestyle() == style
+                            and to_rgb(line.get_color()) == colour
+                            and np.allclose(np.asarray(line.get_ydata(), dtype=float), want)]
+                    assert len(hits) == 1, (letter, label, name)
+    labels = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert {"(a, c, e) constant interface", "(b, d, f) hard coating", "dashed: analytical model"} <= set(labels)
+    notes = [text for text in labels if text.startswith("note:")]
+    assert len(notes) == 1 and "mu_sh" in notes[0] and "Fn / H" in notes[0]
+    assert "docs/journal/2026-12-02-interface-shear-split.md" in notes[0]
+    plt.close(fig)
+
+    fig = _drawn_figure("fig11", _written(build_dataset(SMOKE, "fig11", run_files), tmp_path), monkeypatch)
+    assert [ax.get_ylabel() for ax in fig.axes] == [mpm_figures.QUANTITY["dp"][0]] * 2
+    assert [ax.get_title() for ax in fig.axes] == ["(a) vs hardness ratio H~", "(b) vs coating thickness t"]
+    assert not [t for t in fig.legends[0].get_texts() if t.get_text().startswith("note:")]
+    plt.close(fig)
+
+
+def test_fig13_png_holds_the_three_rows(run_files, tmp_path):
+    """The saved PNG is the three-row figure: taller than Fig. 11's single row at the same width."""
+    import matplotlib.image
+
+    sizes = {}
+    for figure in ("fig11", "fig13"):
+        png = tmp_path / f"{figure}.png"
+        plot(figure, _written(build_dataset(SMOKE, figure, run_files), tmp_path), [png])
+        sizes[figure] = matplotlib.image.imread(png).shape[:2]
+    assert sizes["fig13"][1] == sizes["fig11"][1] and sizes["fig13"][0] > 2 * sizes["fig11"][0]
+
+
 def test_fig18_thickness_panel_and_bulk_panel(run_files, tmp_path):
     ds = build_dataset(SMOKE, "fig18", run_files)
     rts = MPM["real_materials"]["thickness_sweep"]

@@ -21,6 +21,7 @@ from plough.figures.style import (
     header,
     lighter,
     new_figure,
+    note_entry,
     ring,
     save,
     shade_where,
@@ -32,7 +33,18 @@ SIZE_MARKERS = ["^", "s", "v", "D", "P"]
 THICKNESS_LINEAR_UM = 10.0
 THICKNESS_TICKS_UM = (0, 2, 4, 6, 8, 10, 20, 50, 100, 200, 500, 1000)
 QUANTITY = {"dp": ("ploughing depth dp (µm)", 1e6), "mu": ("friction coefficient mu (-)", 1.0),
+            "mu_pl": ("ploughing part mu_pl (-)", 1.0), "mu_sh": ("interface-shear part mu_sh (-)", 1.0),
             "penetration": ("penetration under load (µm)", 1e6)}
+#: what a row of Figs. 11 / 13 shows, in its panels' titles
+ROW_TITLES = {"dp": "ploughing depth dp", "mu": "friction mu", "mu_pl": "ploughing part mu_pl",
+              "mu_sh": "interface-shear part mu_sh"}
+#: Fig. 13's rows: mu and its two parts. At strong interface shear the MPM's contact grows (junction growth;
+#: a prow on coated scenes) while the analytical model fixes its area at Fn / H, so the MPM's mu_sh is not
+#: expected to equal the analytical one, its mu_pl is: mu alone would hide which part departs
+#: (docs/journal/2026-12-02-interface-shear-split.md)
+FIG13_ROWS = ("mu", "mu_pl", "mu_sh")
+FIG13_NOTE = ("note: mu_sh is the interface part. The analytical model takes it on the projected front area Fn / H;\n"
+              "the MPM's contact grows under shear (docs/journal/2026-12-02-interface-shear-split.md)")
 #: the extrapolated marks and the line joining them (the trend), drawn above their bars
 MARK_SIZE = 6.0
 TREND_WIDTH = 1.6
@@ -196,15 +208,31 @@ def _thickness_axis(ax, x: np.ndarray) -> None:
         ax.axvline(THICKNESS_LINEAR_UM, color="0.8", lw=0.6, zorder=0)
 
 
-def _fig11_13(ds: xr.Dataset, outputs, quantity: str, figure: str) -> None:
-    fig, axes = new_figure(1, 2, height_per_row=4.4)
+def _fig11_13(ds: xr.Dataset, outputs, quantities: tuple[str, ...], figure: str,
+              notes: tuple[tuple[Artist, str], ...] = ()) -> None:
+    """Figs. 11 / 13: one row per quantity, (left) against the hardness ratio, (right) against the coating
+    thickness; panels lettered row by row, one key, ``notes`` at its end."""
+    rows = len(quantities)
+    fig, axes = new_figure(rows, 2, height_per_row=4.4 if rows == 1 else 3.6)
     t_a = float(ds.attrs.get("ratio_sweep_thickness_um", np.nan))
-    a = _sweep_panel(axes[0, 0], ds, quantity, "_a", logx=True, thickness_um=t_a if np.isfinite(t_a) else None,
-                     panel="a")
-    axes[0, 0].set_title("(a) vs hardness ratio H~", fontsize=10)
-    b = _sweep_panel(axes[0, 1], ds, quantity, "_b", thickness_axis=True, panel="b")
-    axes[0, 1].set_title("(b) vs coating thickness t", fontsize=10)
-    header(fig, figure, _series_first(a, b), ncol=4)
+    letters = [(chr(ord("a") + 2 * r), chr(ord("b") + 2 * r)) for r in range(rows)]
+    # a column's series are the same in every row: named once in the key, with every panel they appear in
+    left, right = (", ".join(pair[c] for pair in letters) for c in (0, 1))
+    entries: list[list[tuple[Artist, str]]] = []
+    for r, quantity in enumerate(quantities):
+        ax_a, ax_b = axes[r, 0], axes[r, 1]
+        entries.append(_sweep_panel(ax_a, ds, quantity, "_a", logx=True,
+                                    thickness_um=t_a if np.isfinite(t_a) else None, panel=left))
+        entries.append(_sweep_panel(ax_b, ds, quantity, "_b", thickness_axis=True, panel=right))
+        what = f"{ROW_TITLES[quantity]} " if rows > 1 else ""  # one row: the figure's title says what
+        ax_a.set_title(f"({letters[r][0]}) {what}vs hardness ratio H~", fontsize=10)
+        ax_b.set_title(f"({letters[r][1]}) {what}vs coating thickness t", fontsize=10)
+        if r < rows - 1:  # the rows share their x axes: labelled once, under the last row
+            ax_a.set_xlabel("")
+            ax_b.set_xlabel("")
+    # one row: four columns, every series in the first line; more rows: two columns, so that each line holds
+    # the series of one column of panels (two each), then the encodings two by two
+    header(fig, figure, [*_series_first(*entries), *notes], ncol=4 if rows == 1 else 2)
     save(fig, outputs)
 
 
@@ -215,11 +243,11 @@ def _series_first(*panels: list[tuple[Artist, str]]) -> list[tuple[Artist, str]]
 
 
 def plot_fig11(ds: xr.Dataset, outputs) -> None:
-    _fig11_13(ds, outputs, "dp", "fig11")
+    _fig11_13(ds, outputs, ("dp",), "fig11")
 
 
 def plot_fig13(ds: xr.Dataset, outputs) -> None:
-    _fig11_13(ds, outputs, "mu", "fig13")
+    _fig11_13(ds, outputs, FIG13_ROWS, "fig13", notes=((note_entry("0.25"), FIG13_NOTE),))
 
 
 def _vs_load(quantity: str, figure: str):

@@ -40,7 +40,7 @@ QUESTIONS = {
     "fig04": "Fig. 4: How deep does the sphere plough as the coating's thickness and hardness change?",
     "fig11": "Fig. 11: Does the MPM ploughing depth follow the analytical model over hardness and thickness?",
     "fig12": "Fig. 12: Does the soft coating pile up ahead of the sphere, and do the forces settle?",
-    "fig13": "Fig. 13: Does the MPM friction follow the analytical model over hardness and thickness?",
+    "fig13": "Fig. 13: Which part of the MPM friction follows the analytical model over hardness and thickness?",
     "fig14": "Fig. 14: Where does the zinc coating go when the ball ploughs it?",
     "fig15": "Fig. 15: Does zinc plough deeper than DX56 steel as the load rises?",
     "fig16": "Fig. 16: Does the larger ball plough less into zinc-coated steel?",

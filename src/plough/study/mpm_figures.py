@@ -32,7 +32,7 @@ from plough.study.skipping import is_failed, is_skipped
 TITLES = {
     "fig11": "Fig. 11 - ploughing depth dp, MPM vs analytical, rigid-plastic coating",
     "fig12": "Fig. 12 - soft coating piling up ahead of the sphere, and the forces while sliding",
-    "fig13": "Fig. 13 - friction coefficient mu, MPM vs analytical, rigid-plastic coating",
+    "fig13": "Fig. 13 - friction coefficient mu and its parts mu_pl, mu_sh, MPM vs analytical, rigid-plastic coating",
     "fig14": "Fig. 14 - zinc-coated steel ploughed by a ball: height map, residual cross-section, materials",
     "fig15": "Fig. 15 - ploughing depth vs load, zinc block and DX56 steel",
     "fig16": "Fig. 16 - ploughing depth vs load, zinc-coated steel, two ball sizes",
