@@ -81,7 +81,8 @@ def tiny_sliding_scene(symmetric: bool, graded: bool = False) -> Scene:
         "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
         "interface": {"model": "proportional", "f": 1.0},
         # graded: a wider block, so that 2 h particles exist outside the 6 h fine zone
-        # a 100 um slide: half and full domains agree to 0.02% (mu) and 0.3% (dp) (0.06% / 0.3% over 200 um), in 40% of the time
+        # a 100 um slide: half and full domains agree to 0.02% (mu) and 0.3% (dp) (0.06% / 0.3% over 200 um),
+        # in 40% of the time
         "domain": {"radius_um": 110 if graded else 80, "length_um": 300, "symmetric": symmetric},
         "sliding": {"distance_um": 100, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
         "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6,
