@@ -3,23 +3,14 @@ the step (run from the repository root). A flowing particle's trial stress is re
 q_trial = 3 G d + sigma_y(eps_p + d, d rate_scale / dt, T)."""
 
 import collections
-from dataclasses import replace
 
-import numba
 import numpy as np
+from zinc_slide import zinc_state_in_slide  # this folder
 
 from plough.mpm import constitutive as c
 from plough.mpm import solver
-from plough.mpm.scene import Scene
 
-numba.set_num_threads(2)
-scene = Scene.from_yaml("examples/zinc_coated_steel.yaml")
-scene = replace(scene, discretisation=replace(scene.discretisation, particle_size_m=10e-6)).with_sized_domain()
-state, const = solver.init(scene)
-while state.sphere.phase != "slide":
-    solver.step(state, const)
-for _ in range(30):
-    solver.step(state, const)
+state, const = zinc_state_in_slide(30)
 P = state.particles
 table, dt, rs = const.table, const.dt, const.rate_scale
 hist: collections.Counter = collections.Counter()

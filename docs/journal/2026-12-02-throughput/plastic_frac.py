@@ -1,22 +1,13 @@
 """How many particles of the zinc-coated steel scene (h = 10 um) flow on a step (run from the repository root)."""
 
 import time
-from dataclasses import replace
 
-import numba
 import numpy as np
+from zinc_slide import zinc_state_in_slide  # this folder
 
 from plough.mpm import solver
-from plough.mpm.scene import Scene
 
-numba.set_num_threads(2)
-scene = Scene.from_yaml("examples/zinc_coated_steel.yaml")
-scene = replace(scene, discretisation=replace(scene.discretisation, particle_size_m=10e-6)).with_sized_domain()
-state, const = solver.init(scene)
-while state.sphere.phase != "slide":
-    solver.step(state, const)
-for _ in range(50):
-    solver.step(state, const)
+state, const = zinc_state_in_slide(50)
 P = state.particles
 flowing = []
 t0 = time.perf_counter()

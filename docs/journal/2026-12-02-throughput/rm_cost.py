@@ -5,21 +5,12 @@ rest is set out of reach, so that no particle calls the return map (four pairs).
 """
 
 import time
-from dataclasses import replace
 
-import numba
+from zinc_slide import zinc_state_in_slide  # this folder
 
 from plough.mpm import solver, transfers
-from plough.mpm.scene import Scene
 
-numba.set_num_threads(2)
-scene = Scene.from_yaml("examples/zinc_coated_steel.yaml")
-scene = replace(scene, discretisation=replace(scene.discretisation, particle_size_m=10e-6)).with_sized_domain()
-state, const = solver.init(scene)
-while state.sphere.phase != "slide":
-    solver.step(state, const)
-for _ in range(30):
-    solver.step(state, const)
+state, const = zinc_state_in_slide(30)
 original = transfers.g2p_update
 spent = [0.0]
 
