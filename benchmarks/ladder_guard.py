@@ -45,7 +45,7 @@ sys.path.insert(0, str(ROOT / "src"))
 from plough.fingerprint import solver_fingerprint  # noqa: E402
 from plough.io import provenance_attrs  # noqa: E402
 from plough.study import matrix, skipping  # noqa: E402
-from plough.study.extrapolation import Method, extrapolate, sampling_error  # noqa: E402
+from plough.study.extrapolation import Method, extrapolate, sampling_error, total_uncertainty  # noqa: E402
 from plough.study.plan import load_config  # noqa: E402
 from plough.study.runfiles import load_run  # noqa: E402
 
@@ -87,7 +87,7 @@ def limit(sizes_um: tuple[float, ...], values: list[float], errors: list[float])
     gci = float(ex.uncertainty)
     return {"sizes_um": list(sizes_um), "value": float(ex.value), "uncertainty_gci": gci,
             "sampling_error": finite_or_none(se), "sampling_error_missing": not np.isfinite(se),
-            "uncertainty": float(np.hypot(gci, np.nan_to_num(se, nan=0.0))), "order": finite_or_none(float(ex.order)),
+            "uncertainty": float(total_uncertainty(gci, se)), "order": finite_or_none(float(ex.order)),
             "method": Method(int(ex.method)).name.lower(), "flagged": bool(ex.flagged)}
 
 

@@ -253,8 +253,8 @@ def test_jackknife_of_a_mean_is_the_batch_means_standard_error():
 
 def test_standard_errors_of_the_window_and_the_sections():
     """A constant force has no sampling error; Fx alternating between batch halves of the window
-    gives mu's jackknife error from its two values; records outside the window do not count; dp's
-    error comes from the sections' scatter of depth."""
+    gives mu's jackknife error from its two values; records outside the window do not count; the
+    groove's errors come from the sections' scatter of depth and the lattice-phase term in quadrature."""
     n, k = 40, io.SE_BATCHES
     mask = np.arange(n) >= 20  # 20 records: 10 batches of 2
     fz = np.full(n, 2.0)
@@ -264,7 +264,8 @@ def test_standard_errors_of_the_window_and_the_sections():
     y = np.array([0.0, 10e-6, 20e-6, 100e-6])
     depth = np.array([2e-6, 4e-6, 2e-6, 4e-6])  # four sections, two groove depths; pile-up 1 um
     prof = np.array([[-d, -d, 0.0, 1e-6] for d in depth])
-    out = io.standard_errors(series, mask, y, prof, contact_radius=15e-6)
+    h = 5e-6
+    out = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, particle_size_m=h)
     theta = np.array([(fx[20:].sum() - fx[20 + 2 * b: 22 + 2 * b].sum()) / (fz[20:].sum() - 4.0) for b in range(k)])
     expected = np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2))
     assert out["mu_standard_error"] == pytest.approx(expected, rel=1e-12) and expected > 0
@@ -273,9 +274,17 @@ def test_standard_errors_of_the_window_and_the_sections():
     # dp = mean depth + 1 um; leave one section of four out: depth 8/3 or 10/3 um, two each
     dp_theta = np.array([10 / 3, 8 / 3, 10 / 3, 8 / 3]) * 1e-6
     dp_expected = np.sqrt(3 / 4 * np.sum((dp_theta - dp_theta.mean()) ** 2))
-    assert out["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
-    # one section: dp's error cannot be estimated and is left out, not written as NaN or 0
-    assert "dp_standard_error" not in io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6)
+    phase = io.GROOVE_LATTICE_PHASE_ERROR_H * h
+    assert 0 < phase < dp_expected
+    assert out["dp_standard_error"] == pytest.approx(np.hypot(dp_expected, phase), rel=1e-12)
+    assert out["dg_standard_error"] == pytest.approx(np.hypot(dp_expected, phase), rel=1e-12)  # dg carries dp's scatter
+    assert out["hpu_standard_error"] == 0.0  # the same pile-up in every section, and hpu has no phase term
+    no_phase = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, particle_size_m=0.0)
+    assert no_phase["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
+    assert no_phase["hpu_standard_error"] == 0.0
+    # one section: the groove's errors cannot be estimated and are left out, not written as NaN or 0
+    one = io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6, particle_size_m=h)
+    assert not {"dp_standard_error", "dg_standard_error", "hpu_standard_error"} & set(one)
 
 
 def test_contact_summary_of_the_shear_split():

@@ -10,6 +10,7 @@ from plough.study.extrapolation import (
     extrapolate,
     extrapolate_dataarray,
     sampling_error,
+    total_uncertainty,
 )
 
 F0 = 0.3
@@ -373,3 +374,14 @@ def test_sampling_error_of_converged_missing_and_vectorised_points():
     np.testing.assert_allclose(sampling_error(h, f.reshape(5, 1, 3), se.reshape(5, 1, 3)).ravel(), out)
     with pytest.raises(ValueError, match="standard_error"):
         sampling_error(h, f, se[:, :2])
+
+
+def test_total_uncertainty_adds_the_sampling_error_in_quadrature_and_says_what_a_missing_one_counts_as():
+    np.testing.assert_allclose(total_uncertainty([3.0, 0.0], [4.0, 2.0]), [5.0, 2.0])
+    # the figures and the ladder guard: a missing sampling error leaves the discretisation uncertainty alone
+    np.testing.assert_allclose(total_uncertainty([3.0, 1.0], [np.nan, 0.0]), [3.0, 1.0])
+    # the refinement decision: an unknown error makes an unknown total, never a small one
+    out = total_uncertainty([3.0, 3.0], [np.nan, 4.0], missing_sampling="unknown")
+    assert np.isnan(out[0]) and out[1] == pytest.approx(5.0)
+    with pytest.raises(ValueError, match="missing_sampling = 'zero'"):
+        total_uncertainty(1.0, 1.0, missing_sampling="zero")

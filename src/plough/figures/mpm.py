@@ -26,6 +26,7 @@ from plough.figures.style import (
     save,
     shade_where,
 )
+from plough.study.extrapolation import total_uncertainty
 
 SERIES_COLOURS = ["tab:blue", "tab:red", "tab:green", "tab:purple", "tab:orange"]
 SIZE_MARKERS = ["^", "s", "v", "D", "P"]
@@ -119,7 +120,7 @@ def _sweep_panel(ax, ds: xr.Dataset, quantity: str, suffix: str, *, logx: bool =
         unc = ds[f"{quantity}_h0_uncertainty{suffix}"].sel(sel).values * scale
         sampling = ds.get(f"{quantity}_h0_sampling_error{suffix}")
         if sampling is not None:  # the runs' own noise carried to the limit, in quadrature with the GCI
-            unc = np.hypot(unc, np.nan_to_num(sampling.sel(sel).values * scale, nan=0.0))
+            unc = total_uncertainty(unc, sampling.sel(sel).values * scale)
         flagged = ds[f"{quantity}_h0_flagged{suffix}"].sel(sel).values.astype(bool)
         any_flagged |= bool(flagged.any())
         ax.errorbar(x, val, yerr=unc, fmt="none", ecolor=lighter(colour), elinewidth=1.0, capsize=2, zorder=2)

@@ -117,12 +117,25 @@ STEADY_META = {
 
 #: contiguous batches the steady window's records and the residual sections are cut into for the jackknife
 SE_BATCHES = 10
+#: one run's groove depth (dg, and dp = dg + hpu with it) moves with where the sphere starts against the particle
+#: lattice by about a tenth of a particle size beyond what the jackknife over the residual sections sees: this
+#: term, times the particle size, is added to their standard errors in quadrature (calibrated on phase-shifted
+#: runs: docs/verification.md, "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md). The
+#: pile-up height's phase noise is a few hundredths of a particle, which its jackknife covers: hpu has no term.
+GROOVE_LATTICE_PHASE_ERROR_H = 0.1
+GROOVE_OUTPUTS = ("dp", "dg", "hpu")
+PHASE_TERM_OUTPUTS = ("dp", "dg")
+_SECTIONS_JACKKNIFE = f"the jackknife over up to {SE_BATCHES} contiguous batches of the residual sections"
 STANDARD_ERROR_META = {
     f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over up to {SE_BATCHES} "
                                     "contiguous batches of the steady window's records)")
     for name in ("mu", "mu_pl", "mu_sh")
-} | {"dp_standard_error": ("m", f"sampling standard error of dp (jackknife over up to {SE_BATCHES} contiguous "
-                                "batches of the residual sections)")}
+} | {
+    f"{name}_standard_error": ("m", f"standard error of {name}: {_SECTIONS_JACKKNIFE} and the lattice-phase "
+                                    f"term {GROOVE_LATTICE_PHASE_ERROR_H:g} h (attribute lattice_phase_term_m) in "
+                                    "quadrature")
+    for name in PHASE_TERM_OUTPUTS
+} | {"hpu_standard_error": ("m", f"standard error of hpu: {_SECTIONS_JACKKNIFE}")}
 
 #: a window is steady when mu moves by at most this fraction between its halves ...
 STEADY_MU_DRIFT = 0.05
@@ -296,14 +309,18 @@ def jackknife_standard_error(statistic: Callable[[np.ndarray], float], n: int,
 
 
 def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarray, prof: np.ndarray,
-                    contact_radius: float) -> dict[str, float]:
-    """Sampling standard errors of the steady-state results (``STANDARD_ERROR_META``).
+                    contact_radius: float, particle_size_m: float) -> dict[str, float]:
+    """Standard errors of the steady-state results (``STANDARD_ERROR_META``).
 
     The steady window is a finite sample of a fluctuating force and the residual groove a finite
-    number of sections: these errors estimate how far the same run with a different but equally
-    long sample (the sphere started elsewhere against the particle lattice) would move mu and dp;
-    measured against such runs they are order-of-magnitude bars (docs/journal/2026-11-23-lattice-phase.md). dp's
-    error is omitted when fewer than 2 sections were measured.
+    number of sections: the jackknife estimates how far the same run with a different but equally
+    long sample would move mu and the groove. The groove depth's errors (dg, dp) also carry the
+    lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H * particle_size_m`` in quadrature: where the
+    sphere starts against the particle lattice moves the groove's bottom by about a tenth of a particle
+    size beyond the jackknife's reach (a groove a fraction of a particle deep shows no scatter over its
+    sections at all); the pile-up height's jackknife covers its own phase noise. mu's errors carry no
+    such term: measured against phase-shifted runs they are order-of-magnitude bars (docs/verification.md,
+    "Noise and reproducibility"). The groove's errors are omitted when fewer than 2 sections were measured.
     """
     idx = np.flatnonzero(mask)
     fx, fz = series["Fx"][idx], series["Fz"][idx]
@@ -312,10 +329,13 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
         se = jackknife_standard_error(lambda k, part=part: part[k].sum() / fz[k].sum(), idx.size)
         if se is not None:
             out[f"{name}_standard_error"] = se
-    se = jackknife_standard_error(lambda k: sum(groove_depths(y, _nanmean_rows(prof[k]), contact_radius)),
-                                  prof.shape[0])
-    if se is not None:
-        out["dp_standard_error"] = se
+    phase = GROOVE_LATTICE_PHASE_ERROR_H * particle_size_m
+    groove = {"dp": sum, "dg": lambda d: d[0], "hpu": lambda d: d[1]}
+    for name, pick in groove.items():
+        se = jackknife_standard_error(
+            lambda k, pick=pick: pick(groove_depths(y, _nanmean_rows(prof[k]), contact_radius)), prof.shape[0])
+        if se is not None:
+            out[f"{name}_standard_error"] = float(np.hypot(se, phase)) if name in PHASE_TERM_OUTPUTS else se
     return out
 
 
@@ -393,8 +413,6 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     the steady window and the residual sections then refer to it.
     """
     slid_total = scene.sliding.distance_m if slid_distance_m is None else slid_distance_m
-    if scene.discretisation.contact == "particle":  # the split is the grid contact's: the particle contact has none
-        series = {k: v for k, v in series.items() if k not in CONTACT_SPLIT_META}
     mask = steady_window_mask(slid_m, scene, slid_total)
     if mask.sum() < 3:
         raise ValueError("fewer than 3 records in the steady window; raise outputs.records")
@@ -435,9 +453,12 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         for name, value in contact_summary(series, mask, Fz).items():
             u, ln = CONTACT_SUMMARY_META[name]
             ds[name] = ((), float(value), {"units": u, "long_name": ln})
-    for name, value in standard_errors(series, mask, y, prof, a_exp).items():
+    h = scene.discretisation.particle_size_m
+    for name, value in standard_errors(series, mask, y, prof, a_exp, h).items():
         u, ln = STANDARD_ERROR_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
+        if name.removesuffix("_standard_error") in PHASE_TERM_OUTPUTS:
+            ds[name].attrs["lattice_phase_term_m"] = GROOVE_LATTICE_PHASE_ERROR_H * h
     for name, value in steadiness(series, mask, scene.discretisation.particle_size_m).items():
         u, ln = STEADINESS_META[name]
         ds[name] = ((), np.int8(value) if name == "steady" else value, {"units": u, "long_name": ln})

@@ -51,10 +51,15 @@ SPLIT_NAMES, SPLIT_CHANNELS, SPLIT_SIGNS = _split_channels()
 
 
 class _Recorder:
-    """Interval means of the per-step forces and snapshots of the energies, every ``every`` steps."""
+    """Interval means of the per-step forces and snapshots of the energies, every ``every`` steps.
 
-    def __init__(self, every: int) -> None:
+    ``split``: whether to record the grid contact's split of its interface shear (SPLIT_NAMES); the particle
+    contact has no such split, so its runs record none (and their result files hold no empty series).
+    """
+
+    def __init__(self, every: int, split: bool = True) -> None:
         self.every = max(int(every), 1)
+        self.split = split
         self.rows: list[dict[str, float]] = []
         self.slid: list[float] = []
         self._sum = np.zeros(7)
@@ -69,7 +74,8 @@ class _Recorder:
         fn, ft = k * out[contact.OUT_FN:contact.OUT_FN + 3], k * out[contact.OUT_FT:contact.OUT_FT + 3]
         fy = 0.0 if k == 2.0 else fn[1] + ft[1]
         self._sum += np.array([-(fn[0] + ft[0]), fy, fn[2] + ft[2], -fn[0], -ft[0], fn[2], ft[2]])
-        self._split += k * SPLIT_SIGNS * out[SPLIT_CHANNELS]
+        if self.split:
+            self._split += k * SPLIT_SIGNS * out[SPLIT_CHANNELS]
         self._count += 1
         pen = float(s.work.acc[:, transfers.ACC_PENETRATION].max())
         self.max_penetration = max(self.max_penetration, pen)
@@ -92,8 +98,9 @@ class _Recorder:
             "interface_dissipation": k * w.interface_dissipation, "contact_impact_loss": k * w.contact_impact_loss,
             "frozen_kinetic_loss": k * s.zone.frozen_kinetic_loss_J,
             "heat": k * w.heat, "time": s.time,
-            **dict(zip(SPLIT_NAMES, (self._split / self._count).tolist(), strict=True)),
         })
+        if self.split:
+            self.rows[-1].update(zip(SPLIT_NAMES, (self._split / self._count).tolist(), strict=True))
         self.slid.append(s.sphere.slid_m if s.sphere.phase in ("slide", "done") else 0.0)
         self._sum[:] = 0.0
         self._split[:] = 0.0
@@ -174,7 +181,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     state, const = solver.init(scene)
     max_press_steps = int(10 * scene.sphere.radius_m / (const.press_speed * const.dt))
     grid_nodes_start = const.grid.n_nodes  # the grid may grow (plough.mpm.growth)
-    rec = _Recorder(const.steps_slide / scene.outputs.records)
+    rec = _Recorder(const.steps_slide / scene.outputs.records, split=scene.discretisation.contact != "particle")
     n_snap = scene.outputs.snapshots
     snap_every = scene.sliding.distance_m / n_snap if n_snap else np.inf
     next_snap = 0.0

@@ -64,6 +64,7 @@ __all__ = [
     "extrapolate",
     "extrapolate_dataarray",
     "sampling_error",
+    "total_uncertainty",
 ]
 
 #: Roache's safety factors: 1.25 when the order is observed (three or more sizes), 3 when assumed.
@@ -337,6 +338,25 @@ def sampling_error(h: ArrayLike, f: ArrayLike, standard_error: ArrayLike) -> NDA
     out = np.sqrt(np.sum(np.where(used, weights * se, 0.0) ** 2, axis=-1))
     out[np.any(used & ~np.isfinite(se), axis=-1) | (method == Method.MISSING)] = np.nan
     return out.reshape(ex.value.shape)
+
+
+def total_uncertainty(uncertainty: ArrayLike, sampling: ArrayLike, *,
+                      missing_sampling: str = "none") -> NDArray[np.float64]:
+    """The uncertainty of an extrapolated value as plough reports it: the discretisation uncertainty
+    (``Extrapolation.uncertainty``, GCI-type) and the runs' sampling error carried to the limit
+    (:func:`sampling_error`) in quadrature, as independent errors.
+
+    ``missing_sampling`` says what a missing (NaN) sampling error counts as: ``"none"`` (the
+    discretisation uncertainty alone: the figures, the ladder guard, which say so where it matters)
+    or ``"unknown"`` (a NaN total: the refinement decision, which must never skip a run on an
+    unknown error).
+    """
+    if missing_sampling not in ("none", "unknown"):
+        raise ValueError(f"missing_sampling = {missing_sampling!r}; allowed: 'none', 'unknown'")
+    s = np.asarray(sampling, dtype=float)
+    if missing_sampling == "none":
+        s = np.nan_to_num(s, nan=0.0)
+    return np.hypot(np.asarray(uncertainty, dtype=float), s)
 
 
 def extrapolate_dataarray(

@@ -45,7 +45,7 @@ import xarray as xr
 
 from plough.io import provenance_attrs
 from plough.mpm.io import STANDARD_ERROR_META
-from plough.study.extrapolation import extrapolate, sampling_error
+from plough.study.extrapolation import extrapolate, sampling_error, total_uncertainty
 
 #: Outputs whose two-size extrapolation must be within the tolerance to skip the finest run.
 CHECKED = ("mu", "dp")
@@ -72,7 +72,7 @@ def two_size_extrapolation(coarse: xr.Dataset, mid: xr.Dataset, h_coarse_um: flo
         ex = extrapolate(h, f)
         sampling = float(sampling_error(h, f, [_run_error(run, o) for run in (coarse, mid)]))
         value, unc = float(ex.value), float(ex.uncertainty)
-        total = float(np.hypot(unc, sampling))
+        total = float(total_uncertainty(unc, sampling, missing_sampling="unknown"))
         rel = total / abs(value) if value != 0 else (0.0 if total == 0 else np.inf)
         out[o] = {"value": value, "uncertainty": unc, "sampling_error": sampling, "relative_uncertainty": rel}
     return out
