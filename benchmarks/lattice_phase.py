@@ -10,9 +10,8 @@ physical meaning. Each case runs the scene with the workflow's numerics (graded 
 phi = 0, 1/N, ..., (N-1)/N. The spread of mu and dp over the phases is the noise floor of a single
 run: two settings whose results differ by less than it cannot be told apart with one run each. It
 is set beside each run's own error (``mu_standard_error``: the jackknife over the steady window's
-records; ``dp_standard_error``, ``dg_...``: the jackknife over the residual sections and the
-lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H * h`` in quadrature; ``hpu_...``: the jackknife alone;
-``plough.mpm.io``) to see
+records; ``dp_standard_error``, ``dg_...``, ``hpu_...``: the jackknife over the residual sections and
+the lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H * h`` in quadrature, ``plough.mpm.io``) to see
 whether that error, which every result file carries, measures this noise: per quantity the median
 error, the spread over its median, and the root mean square of the runs' z-scores
 ``(value - mean over the phases) / error * sqrt(n / (n - 1))`` (1 for a calibrated error, below 1 for
@@ -54,7 +53,7 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
             warnings.simplefilter("ignore")  # unsteady windows are reported in the row (mu_drift, steady)
             ds = simulate(scene, progress=False, threads=threads)
         row = {q: float(ds[q]) if q in ds else float("nan") for q in KEEP}  # the groove's errors may be left out
-        row["lattice_phase_term_m"] = io.GROOVE_LATTICE_PHASE_ERROR_H * h  # in dp's and dg's errors
+        row["lattice_phase_term_m"] = io.GROOVE_LATTICE_PHASE_ERROR_H * h  # in the groove's errors
         row.update(phase=k / phases, start_x_m=scene.start_x_m, wall_s=time.perf_counter() - t0,
                    particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]))
         runs.append(row)
@@ -70,9 +69,8 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
                       "median_standard_error": float(np.nanmedian(se)),
                       "std_over_median_standard_error": float(v.std(ddof=1) / np.nanmedian(se)),
                       "rms_z": rms_z(v, se)}
-        if q in GROOVE:  # the jackknife part alone: the error without the lattice-phase term (hpu has none)
-            term = io.GROOVE_LATTICE_PHASE_ERROR_H * h if q in io.PHASE_TERM_OUTPUTS else 0.0
-            jack = np.sqrt(np.maximum(se**2 - term**2, 0.0))
+        if q in GROOVE:  # the jackknife part alone: the error without the lattice-phase term
+            jack = np.sqrt(np.maximum(se**2 - (io.GROOVE_LATTICE_PHASE_ERROR_H * h) ** 2, 0.0))
             summary[q]["rms_z_jackknife_only"] = rms_z(v, jack)
     return {"scene": name, "h_um": h_um, "phases": phases, "runs": runs, "summary": summary}
 

@@ -278,7 +278,7 @@ def test_standard_errors_of_the_window_and_the_sections():
     assert 0 < phase < dp_expected
     assert out["dp_standard_error"] == pytest.approx(np.hypot(dp_expected, phase), rel=1e-12)
     assert out["dg_standard_error"] == pytest.approx(np.hypot(dp_expected, phase), rel=1e-12)  # dg carries dp's scatter
-    assert out["hpu_standard_error"] == 0.0  # the same pile-up in every section, and hpu has no phase term
+    assert out["hpu_standard_error"] == pytest.approx(phase, rel=1e-12)  # the same pile-up in every section
     no_phase = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, particle_size_m=0.0)
     assert no_phase["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
     assert no_phase["hpu_standard_error"] == 0.0

@@ -117,25 +117,24 @@ STEADY_META = {
 
 #: contiguous batches the steady window's records and the residual sections are cut into for the jackknife
 SE_BATCHES = 10
-#: one run's groove depth (dg, and dp = dg + hpu with it) moves with where the sphere starts against the particle
-#: lattice by about a tenth of a particle size beyond what the jackknife over the residual sections sees: this
-#: term, times the particle size, is added to their standard errors in quadrature (calibrated on phase-shifted
-#: runs: docs/verification.md, "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md). The
-#: pile-up height's phase noise is a few hundredths of a particle, which its jackknife covers: hpu has no term.
+#: one run's groove (dg, hpu, dp) moves with where the sphere starts against the particle lattice by up to about a
+#: tenth of a particle size beyond what the jackknife over the residual sections sees: this term, times the particle
+#: size, is added to their standard errors in quadrature (calibrated on phase-shifted runs: docs/verification.md,
+#: "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md; for hpu, whose noise is smaller, it
+#: errs on the safe side)
 GROOVE_LATTICE_PHASE_ERROR_H = 0.1
 GROOVE_OUTPUTS = ("dp", "dg", "hpu")
-PHASE_TERM_OUTPUTS = ("dp", "dg")
-_SECTIONS_JACKKNIFE = f"the jackknife over up to {SE_BATCHES} contiguous batches of the residual sections"
 STANDARD_ERROR_META = {
     f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over up to {SE_BATCHES} "
                                     "contiguous batches of the steady window's records)")
     for name in ("mu", "mu_pl", "mu_sh")
 } | {
-    f"{name}_standard_error": ("m", f"standard error of {name}: {_SECTIONS_JACKKNIFE} and the lattice-phase "
-                                    f"term {GROOVE_LATTICE_PHASE_ERROR_H:g} h (attribute lattice_phase_term_m) in "
+    f"{name}_standard_error": ("m", f"standard error of {name}: the jackknife over up to {SE_BATCHES} contiguous "
+                                    "batches of the residual sections and the lattice-phase term "
+                                    f"{GROOVE_LATTICE_PHASE_ERROR_H:g} h (attribute lattice_phase_term_m) in "
                                     "quadrature")
-    for name in PHASE_TERM_OUTPUTS
-} | {"hpu_standard_error": ("m", f"standard error of hpu: {_SECTIONS_JACKKNIFE}")}
+    for name in GROOVE_OUTPUTS
+}
 
 #: a window is steady when mu moves by at most this fraction between its halves ...
 STEADY_MU_DRIFT = 0.05
@@ -314,13 +313,13 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
 
     The steady window is a finite sample of a fluctuating force and the residual groove a finite
     number of sections: the jackknife estimates how far the same run with a different but equally
-    long sample would move mu and the groove. The groove depth's errors (dg, dp) also carry the
+    long sample would move mu and the groove. The groove's errors (dp, dg, hpu) also carry the
     lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H * particle_size_m`` in quadrature: where the
-    sphere starts against the particle lattice moves the groove's bottom by about a tenth of a particle
+    sphere starts against the particle lattice moves the groove by up to about a tenth of a particle
     size beyond the jackknife's reach (a groove a fraction of a particle deep shows no scatter over its
-    sections at all); the pile-up height's jackknife covers its own phase noise. mu's errors carry no
-    such term: measured against phase-shifted runs they are order-of-magnitude bars (docs/verification.md,
-    "Noise and reproducibility"). The groove's errors are omitted when fewer than 2 sections were measured.
+    sections at all). mu's errors carry no such term: measured against phase-shifted runs they are
+    order-of-magnitude bars (docs/verification.md, "Noise and reproducibility"). The groove's errors are
+    omitted when fewer than 2 sections were measured.
     """
     idx = np.flatnonzero(mask)
     fx, fz = series["Fx"][idx], series["Fz"][idx]
@@ -335,7 +334,7 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
         se = jackknife_standard_error(
             lambda k, pick=pick: pick(groove_depths(y, _nanmean_rows(prof[k]), contact_radius)), prof.shape[0])
         if se is not None:
-            out[f"{name}_standard_error"] = float(np.hypot(se, phase)) if name in PHASE_TERM_OUTPUTS else se
+            out[f"{name}_standard_error"] = float(np.hypot(se, phase))
     return out
 
 
@@ -457,7 +456,7 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
     for name, value in standard_errors(series, mask, y, prof, a_exp, h).items():
         u, ln = STANDARD_ERROR_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
-        if name.removesuffix("_standard_error") in PHASE_TERM_OUTPUTS:
+        if name.removesuffix("_standard_error") in GROOVE_OUTPUTS:
             ds[name].attrs["lattice_phase_term_m"] = GROOVE_LATTICE_PHASE_ERROR_H * h
     for name, value in steadiness(series, mask, scene.discretisation.particle_size_m).items():
         u, ln = STEADINESS_META[name]
