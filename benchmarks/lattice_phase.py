@@ -32,7 +32,6 @@ import numpy as np
 from common import workflow_scene
 
 from plough.io import git_commit
-from plough.mpm import io
 from plough.mpm.run import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -53,7 +52,8 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
             warnings.simplefilter("ignore")  # unsteady windows are reported in the row (mu_drift, steady)
             ds = simulate(scene, progress=False, threads=threads)
         row = {q: float(ds[q]) if q in ds else float("nan") for q in KEEP}  # the groove's errors may be left out
-        row["lattice_phase_term_m"] = io.GROOVE_LATTICE_PHASE_ERROR_H * h  # in the groove's errors
+        row["lattice_phase_term_m"] = ds["dp_standard_error"].attrs.get("lattice_phase_term_m", 0.0) \
+            if "dp_standard_error" in ds else float("nan")  # the term in the groove's errors, as the run wrote it
         row.update(phase=k / phases, start_x_m=scene.start_x_m, wall_s=time.perf_counter() - t0,
                    particles=int(ds.attrs["cost_particles"]), steps=int(ds.attrs["cost_steps"]))
         runs.append(row)
@@ -70,7 +70,8 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
                       "std_over_median_standard_error": float(v.std(ddof=1) / np.nanmedian(se)),
                       "rms_z": rms_z(v, se)}
         if q in GROOVE:  # the jackknife part alone: the error without the lattice-phase term
-            jack = np.sqrt(np.maximum(se**2 - (io.GROOVE_LATTICE_PHASE_ERROR_H * h) ** 2, 0.0))
+            term = np.array([r["lattice_phase_term_m"] for r in runs])
+            jack = np.sqrt(np.maximum(se**2 - term**2, 0.0))
             summary[q]["rms_z_jackknife_only"] = rms_z(v, jack)
     return {"scene": name, "h_um": h_um, "phases": phases, "runs": runs, "summary": summary}
 

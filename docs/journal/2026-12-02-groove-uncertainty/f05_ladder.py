@@ -50,7 +50,7 @@ def main() -> None:
         runs = []
         for h in args.sizes_um:
             scene = workflow_scene(name, h * 1e-6)
-            scene = replace(scene, interface=ProportionalShear(f=0.5)).with_sized_domain()
+            scene = replace(scene, interface=ProportionalShear(f=0.5))  # the block's size does not depend on f
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore")
                 ds = simulate(scene, progress=False, threads=args.threads)

@@ -458,7 +458,7 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
         if name.removesuffix("_standard_error") in GROOVE_OUTPUTS:
             ds[name].attrs["lattice_phase_term_m"] = GROOVE_LATTICE_PHASE_ERROR_H * h
-    for name, value in steadiness(series, mask, scene.discretisation.particle_size_m).items():
+    for name, value in steadiness(series, mask, h).items():
         u, ln = STEADINESS_META[name]
         ds[name] = ((), np.int8(value) if name == "steady" else value, {"units": u, "long_name": ln})
     ds.attrs["forces_and_energies"] = ("full body (twice the simulated half with the mirror plane)"
