@@ -225,14 +225,18 @@ def surface_share(cbuf, node, mirror_plane):
 
 
 @njit(cache=True, inline="always")
-def _record_split(out, S, speed, area, tau, fx, fz, n, vt, stuck, dist, gap, dx):
+def _record_split(out, S, speed, area, tau, force, n, slip, where, dx):
     """Add one contact node to the diagnostic channels OUT_SH_AREA..OUT_LATERAL_FX; reads only, so the contact
     is the same with or without them. ``area``: its surface share A_i; ``tau``: its interface shear strength;
-    ``fx``: the x force of its tangential impulse on the sphere; ``fz``: the z force of its normal impulse;
-    ``n``: the sphere's outward normal at it; ``vt``: its arriving slip speed; ``stuck``: the impulse stopped
-    the slip (J_t = m v_t, not the traction bound); ``dist``: its distance from the centre; ``gap``: of its
-    closest particle face; S the sphere (centre, radius) and ``speed`` its speed; dx the cell."""
+    ``force`` = (fx, fz): the x force of its tangential impulse on the sphere and the z force of its normal
+    impulse; ``n``: the sphere's outward normal at it; ``slip`` = (vt, stuck): its arriving slip speed and
+    whether the impulse stopped the slip (J_t = m v_t, not the traction bound); ``where`` = (dist, gap): its
+    distance from the centre and the gap of its closest particle face; S the sphere (centre, radius) and
+    ``speed`` its speed; dx the cell."""
+    fx, fz = force
     n0, n1, n2 = n
+    vt, stuck = slip
+    dist, gap = where
     out[OUT_SH_AREA] += area
     out[OUT_SH_TAU_AREA] += tau * area
     region = REGION_FRONT if n0 > 0.0 else REGION_REAR
@@ -377,8 +381,8 @@ def sphere_contact(G, S, law, step, dt, out):
                 out[OUT_NODES] += 1.0
                 if n2 < 0.0:
                     out[OUT_AREA_XY] += area * (-n2)
-                _record_split(out, S, speed, area, tau, fx, -jn * n2 / dt, (n0, n1, n2),
-                              vt, vt > 0.0 and m * vt <= tau * area * dt, dist, gap, dx)
+                _record_split(out, S, speed, area, tau, (fx, -jn * n2 / dt), (n0, n1, n2),
+                              (vt, vt > 0.0 and m * vt <= tau * area * dt), (dist, gap), dx)
 
 
 # ----------------------------------------------------------------------------- contact on the particles

@@ -83,6 +83,17 @@ G2P_BLOCK = 1024
 TRANSFER_FASTMATH = {"contract", "arcp", "nsz", "reassoc", "afn"}
 
 
+@njit(cache=True, inline="always")
+def _chunked_stencil_setup(G, Z):
+    """What P2G and the kinematics share before their loop: the first active particle, their count, the
+    chunks (one per grid copy in G.buf), the grid's y and z node counts, the cell dx, 1 / dx and the APIC
+    D^-1 = 4 / dx^2. Reads G.buf's shape, G.shape, G.dx and Z.p_lo, Z.p_hi; writes nothing."""
+    dx = G.dx
+    inv_dx = 1.0 / dx
+    return (Z.p_lo, Z.p_hi - Z.p_lo, G.buf.shape[0], G.shape[1], G.shape[2], dx, inv_dx,
+            APIC_D_INV_FACTOR * inv_dx * inv_dx)
+
+
 @njit(cache=True, parallel=True, fastmath=TRANSFER_FASTMATH)
 def p2g(P, G, dt, Z):
     """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
@@ -93,13 +104,7 @@ def p2g(P, G, dt, Z):
     Race-free: chunk c owns G.buf[c].
     """
     x, v, C, stress, vol0, J, mass = P.x, P.v, P.C, P.stress, P.vol0, P.J, P.mass
-    p_lo, p_hi = Z.p_lo, Z.p_hi
-    n = p_hi - p_lo
-    n_chunks = G.buf.shape[0]
-    ny, nz = G.shape[1], G.shape[2]
-    dx = G.dx
-    inv_dx = 1.0 / dx
-    dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
+    p_lo, n, n_chunks, ny, nz, dx, inv_dx, dinv = _chunked_stencil_setup(G, Z)
     for c in prange(n_chunks):
         buf = G.buf[c]
         buf[Z.n_lo:Z.n_hi, :] = 0.0
@@ -290,13 +295,7 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
     only G.buf[c].
     """
     x, v, C, mass, grid_v = P.x, P.v, P.C, P.mass, G.v
-    p_lo, p_hi = Z.p_lo, Z.p_hi
-    n = p_hi - p_lo
-    n_chunks = G.buf.shape[0]
-    ny, nz = G.shape[1], G.shape[2]
-    dx = G.dx
-    inv_dx = 1.0 / dx
-    dinv = APIC_D_INV_FACTOR * inv_dx * inv_dx
+    p_lo, n, n_chunks, ny, nz, dx, inv_dx, dinv = _chunked_stencil_setup(G, Z)
     for c in prange(n_chunks):
         buf = G.buf[c]
         if scatter_dilatation:
