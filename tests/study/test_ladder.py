@@ -100,6 +100,42 @@ def test_the_relative_ladder_is_the_coarsest_that_meets_its_targets(targets):
             assert dp / h >= nd or lad.set_by == "contact_radius_particles"
 
 
+#: the five accuracy-guard points of issue 34 (benchmarks/ladder_guard.py; docs/workflow.md, *The ladder*)
+GUARD_POINTS = ("zinc_bulk_bl0.32-0.95_r500_F7", "zinc_bulk_bl0.32-0.95_r500_F11", "rp_Hc450_Hs900_t8_prop1_r200_F3",
+                "rp_Hs450_t0_prop1_r200_F3", "zinc_coating-on-dx56_t15_bl0.32-0.95_r500_F4")
+
+
+def test_a_paper_budget_keeps_the_papers_sizes_where_they_are_cheap():
+    """mpm.ladder_paper_budget_particle_steps: a point the targets coarsen keeps the paper's sizes where they cost
+    at most the budget (the cost model's particle-steps of its paper runs, summed); every other point is as
+    without it. 1e10 holds the five guard points, whose paper ladders cost 4e9-9e9 particle-steps."""
+    plain = copy.deepcopy(CONFIG)
+    plain["mpm"]["ladder_paper_budget_particle_steps"] = None
+    budget = 1e10
+    config = copy.deepcopy(CONFIG)
+    config["mpm"]["ladder_paper_budget_particle_steps"] = budget
+    assert not list(jsonschema.Draft202012Validator(SCHEMA).iter_errors(config))
+    paper_sizes = matrix.particle_sizes_um(config)
+    numerics = config["mpm"]["numerics"]
+    kept = 0
+    for key, p in matrix.all_points(config).items():
+        lad, without = matrix.point_ladder(config, p), matrix.point_ladder(plain, p)
+        steps = sum(cost.estimate(matrix.scene_for(p, h, numerics)).particle_steps for h in paper_sizes)
+        assert matrix.paper_ladder_particle_steps(p, paper_sizes, numerics) == pytest.approx(steps, rel=1e-12)
+        if without.scale > 1.0 and steps <= budget:
+            assert lad.sizes_um == paper_sizes and lad.scale == 1.0 and lad.set_by == "paper_budget", key
+            kept += 1
+        else:
+            assert lad == without, key
+        if key in GUARD_POINTS:
+            assert without.scale == 2.0 and lad.set_by == "paper_budget", key
+    assert kept == 12
+    assert set(GUARD_POINTS) <= set(matrix.all_points(config))
+    for bad in (0, -1.0, "many"):
+        config["mpm"]["ladder_paper_budget_particle_steps"] = bad
+        assert list(jsonschema.Draft202012Validator(SCHEMA).iter_errors(config)), bad
+
+
 def test_the_default_config_within_issue_34s_budget_and_resolved_as_the_validated_scene():
     """config/config.yaml: at most 4e11 particle-steps counted by the cost model (the paper's ladder: 4.16e12),
     every point's finest contact at least as resolved as the rigid-plastic reference scene the paper validated

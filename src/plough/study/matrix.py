@@ -16,6 +16,7 @@ rigid-plastic studies, 3 sigma_y at a plastic strain of 0.08 (Tabor) for the rea
 
 from __future__ import annotations
 
+import json
 import math
 import re
 from dataclasses import dataclass, field, replace
@@ -37,6 +38,7 @@ from plough.mpm.scene import (
     material_from_spec,
     sized_domain,
 )
+from plough.study import cost
 
 #: Steady-state outputs extrapolated to h -> 0 (named as in the analytical model).
 OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp", "dg", "hpu", "penetration")
@@ -355,7 +357,8 @@ class Ladder:
     contact_radius_um: float  # the analytical model's expected contact radius a
     groove_depth_um: float  # its ploughing depth dp
     coating_um: float  # the coating thickness t (0: uncoated)
-    #: the target that set the finest size (a key of LADDER_TARGETS), or "paper"
+    #: the target that set the finest size (a key of LADDER_TARGETS), "paper" (the paper's ladder) or
+    #: "paper_budget" (the relative ladder keeping the paper's sizes of a point they make cheap enough)
     set_by: str
 
     @property
@@ -390,7 +393,12 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     The groove and coating targets never take a point below the config's finest size (k >= 0 for them):
     where the paper's own ladder leaves a groove or a thin coating under a particle, so does this one.
     ``null`` leaves a target out. Sizes are the config's times a power of two, so a run shared by both
-    ladders is one run (its id names its size)."""
+    ladders is one run (its id names its size).
+
+    ``mpm.ladder_paper_budget_particle_steps`` (null: none): a point the targets would coarsen (k > 0) keeps
+    the paper's sizes if they cost at most this many particle-steps together (:func:`paper_ladder_particle_steps`):
+    where the paper's ladder is cheap the relative one saves little and its coarsest size, a contact radius of
+    3-6 particles, widens the extrapolation's uncertainty (docs/workflow.md, *The ladder*)."""
     mpm = config["mpm"]
     paper = particle_sizes_um(config)
     choice = mpm.get("ladder", LADDER_DEFAULT)
@@ -411,8 +419,30 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     if targets.get("coating_particles") is not None and t > 0:
         bounds["coating_particles"] = max(0, _exponent(t, float(targets["coating_particles"]), finest))
     set_by = min(bounds, key=lambda name: bounds[name])  # the first of equals: the contact before the others
+    budget = mpm.get("ladder_paper_budget_particle_steps")
+    if (bounds[set_by] > 0 and budget is not None
+            and paper_ladder_particle_steps(point, paper, mpm["numerics"]) <= float(budget)):
+        return Ladder(paper, 1.0, a, dp, t, "paper_budget")
     scale = 2.0 ** bounds[set_by]
     return Ladder(tuple(h * scale for h in paper), scale, a, dp, t, set_by)
+
+
+def paper_ladder_particle_steps(point: Point, sizes_um: tuple[float, ...], numerics: dict[str, Any]) -> float:
+    """The particle-steps of ``point``'s runs at ``sizes_um`` (the paper's ladder) with the numerics, by the cost
+    model (:func:`plough.study.cost.estimate`: particles x steps x the active zone's share), summed."""
+    numerics_key = json.dumps(numerics, sort_keys=True)
+    total = 0.0
+    for h in sizes_um:
+        # a point's key names one physical point (all_points checks it): the key, size and numerics name the run
+        key = (point.key, float(h), numerics_key)
+        if key not in _PARTICLE_STEPS:
+            _PARTICLE_STEPS[key] = cost.estimate(scene_for(point, float(h), numerics)).particle_steps
+        total += _PARTICLE_STEPS[key]
+    return total
+
+
+#: (point key, h in um, numerics as JSON) -> the run's particle-steps (the ladder asks for each point often)
+_PARTICLE_STEPS: dict[tuple[str, float, str], float] = {}
 
 
 def run_id(point: Point, h_um: float) -> str:
