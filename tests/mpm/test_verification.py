@@ -15,7 +15,7 @@ import numpy as np
 import pytest
 
 from plough.analytical import ploughing
-from plough.materials import ProportionalShear
+from plough.materials import ProportionalShear, representative_hardness
 from plough.mpm import solver
 from plough.mpm.indentation import (
     E_PA,
@@ -128,8 +128,8 @@ def test_ploughing_without_interface_shear_gives_the_analytical_mu_pl_at_h10(nam
     contact a cell outside the sphere): not asserted here."""
     scene = _workflow_example(name, 10.0, 0.0, contact_mode)
     layers = scene.layers
-    hs = 3.0 * layers.substrate.flow.sigma_y_Pa
-    hc = 3.0 * layers.coating.flow.sigma_y_Pa if layers.coated else hs
+    hs = representative_hardness(layers.substrate)  # 3 sigma_y: the Table-2 hardness of a constant flow stress
+    hc = representative_hardness(layers.coating) if layers.coated else hs
     mu_pl = float(ploughing(scene.load_N, scene.sphere.radius_m, layers.coating_thickness_m, hc, hs, f=0.0).mu_pl)
     ds = simulate(scene, progress=False)
     error = float(ds.mu) / mu_pl - 1.0

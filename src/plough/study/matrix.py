@@ -398,7 +398,7 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     ``mpm.ladder_paper_budget_particle_steps`` (null: none): a point the targets would coarsen (k > 0) keeps
     the paper's sizes if they cost at most this many particle-steps together (:func:`paper_ladder_particle_steps`):
     where the paper's ladder is cheap the relative one saves little and its coarsest size, a contact radius of
-    3-6 particles, widens the extrapolation's uncertainty (docs/workflow.md, *The ladder*)."""
+    3-5 particles, widens the extrapolation's uncertainty (docs/workflow.md, *The ladder*)."""
     mpm = config["mpm"]
     paper = particle_sizes_um(config)
     choice = mpm.get("ladder", LADDER_DEFAULT)
