@@ -8,9 +8,11 @@ coating's chip flung ahead) and the high side past the face y = R (material thro
 solver's positions check flags a particle that left the grid (``transfers.BAD_LEFT_GRID``);
 :func:`grow_to_hold` answers the flag after the step's kernels: it grows every face some particle has
 passed, as far as the particles need and the limits and the memory allow, and clears the flag where the
-grown grid holds every particle. Anything else (a particle out through the bottom, the low side, the
-near end, a face that cannot grow as far, the active zone's slabs) is left flagged: the solver's
-``check_stability`` stops the run on it.
+grown grid holds every particle. Before it grows anything it settles the strays (:mod:`plough.mpm.strays`):
+a particle that flowed back out of the active zone's trailing slabs is frozen, one flung past a face's limit
+is retired as debris. Anything else (a particle out through the bottom, the low side, the near end, a face
+that cannot grow as far, the active zone's leading slabs) is left flagged: the solver's ``check_stability``
+stops the run on it.
 
 The origin stays put, so every node keeps its (i, j, k) and position (:func:`grow_grid`); only the
 grid's part of the run's constants (``solver.GrowingGrid``) and the per-node arrays change.
@@ -25,7 +27,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from plough.mpm import contact, transfers
+from plough.mpm import contact, strays, transfers
 from plough.mpm.errors import InstabilityError
 from plough.mpm.grid import extend_node_array, grown
 
@@ -100,13 +102,16 @@ def grow_to_hold(s: State, c: Constants) -> None:
 
 
 def hold(s: State, c: Constants, index: int) -> int:
-    """Grow every face of :data:`FACES` the active particles passed as far as they need and the limits allow;
-    the particle still outside afterwards (``index`` where nothing grew), -1 if none.
+    """Settle the strays (:func:`plough.mpm.strays.settle`: stragglers behind the active zone frozen, debris past
+    the growth limits retired), then grow every face of :data:`FACES` the active particles passed as far as they
+    need and the limits allow; the particle still outside afterwards (``index``, the one flagged, where nothing
+    moved or grew), -1 if none.
 
     All are sized on this step's particles before any grows, and each growth's memory check counts the
     growths that follow it (:func:`grow_face`). Nothing grows where a particle is outside for a reason no
     growth mends (:func:`_outside_for_good`) or past a face that cannot grow as far as it needs: that
     particle is the one named (the far end's first, then the side's, then the top's)."""
+    moved = strays.settle(s, c, hold_reach(c))  # stragglers behind the zone frozen, debris past the limits retired
     stuck = _outside_for_good(s, c)
     if stuck >= 0:
         return stuck
@@ -119,7 +124,8 @@ def hold(s: State, c: Constants, index: int) -> int:
             return z.p_lo + far
     growths = [(axis, layers[axis]) for axis in FACES if layers[axis]]
     if not growths:
-        return index  # nothing to grow: the particle the kernel flagged
+        # nothing to grow: the particle the kernel flagged, or, where strays moved (slots changed), one still out
+        return _outside_index(s) if moved else index
     for i, (axis, _) in enumerate(growths):
         grow_face(s, c, axis, then=tuple(growths[i + 1:]))
     return _outside_index(s)
@@ -153,6 +159,20 @@ def grow_face(s: State, c: Constants, axis: int, then: tuple[tuple[int, int], ..
         return False
     getattr(s, face.log).append((s.step, s.sphere.slid_m, float(c.grid_hi[axis])))
     return True
+
+
+def hold_reach(c: Constants) -> dict[int, float]:
+    """The farthest a particle may be along each growing face's axis for the grid grown to the face's limit to
+    hold it (a cell of room past it, whole node layers: as :func:`_layers_past` counts), m; the faces that do
+    not grow (a hand-set headroom) left out."""
+    reach = {}
+    for axis, face in FACES.items():
+        limit_m = getattr(c, face.limit)
+        if limit_m > 0.0:
+            now, dx = float(c.grid_hi[axis]), c.grid.dx
+            allowed = max(math.floor((limit_m - now) / dx + 1e-9), 0)
+            reach[axis] = now + (allowed - 1 + 1e-9) * dx
+    return reach
 
 
 def _outside_for_good(s: State, c: Constants) -> int:

@@ -50,8 +50,8 @@ SERIES_META = {
     "kinetic_energy": ("J", "kinetic energy (mass-scaled)"),
     "interface_dissipation": ("J", "energy dissipated by interface slip (cumulative)"),
     "contact_impact_loss": ("J", "kinetic energy lost in the inelastic normal contact projection (cumulative)"),
-    "frozen_kinetic_loss": ("J", "kinetic energy of the particles frozen as the active zone left them (cumulative; "
-                                 "0 without an active zone)"),
+    "frozen_kinetic_loss": ("J", "kinetic energy of the particles frozen as the active zone left them, or retired "
+                                 "as debris past the grid's growth limits (cumulative; plough.mpm.strays)"),
     "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),
     "time": ("s", "simulated time"),
 }

@@ -21,6 +21,7 @@ import xarray as xr
 from plough.io import to_json
 from plough.mpm import contact, io, solver, transfers
 from plough.mpm.constitutive import pack_materials
+from plough.mpm.particles import Particles
 from plough.mpm.scene import PRESETS, RESOLVED_CONTACT_PARTICLES, Scene, defaults_taken, read_scene_data
 
 
@@ -91,7 +92,7 @@ class _Recorder:
             "Fx": m[0], "Fy": m[1], "Fz": m[2], "Fx_pl": m[3], "Fx_sh": m[4], "Fz_pl": m[5], "Fz_sh": m[6],
             "depth": c.sphere_radius - s.sphere.centre[2],
             "particle_penetration": pen, "contact_area_xy": k * float(w.contact_out[contact.OUT_AREA_XY]),
-            "material_top": float(s.particles.x[:, 2].max()),
+            "material_top": material_top(s),
             "external_work": k * w.external_work, "plastic_work": k * w.plastic_work,
             "elastic_energy": k * solver.elastic_energy(s, c),
             "kinetic_energy": k * float(acc[:, transfers.ACC_KINETIC].sum()),
@@ -190,7 +191,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     stopper = SteadyStop(scene) if scene.sliding.stop_when_steady else None
     slid_distance = scene.sliding.distance_m
     active_particle_steps = 0
-    raises_told = extensions_told = widenings_told = 0
+    raises_told = extensions_told = widenings_told = retired_told = 0
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
@@ -225,6 +226,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                 step_no, slid_m, side_m = state.grid_widenings[-1]
                 bar.write(f"{scene.name}: material passed the grid's side at step {step_no} ({slid_m * 1e6:.1f} "
                           f"um slid); the grid widened to y = {side_m * 1e6:.1f} um")
+            if bar is not None and len(state.zone.retired_log) > retired_told:
+                retired_told = len(state.zone.retired_log)
+                step_no, slid_m, count = state.zone.retired_log[-1]
+                bar.write(f"{scene.name}: {count} particle(s) flung past the grid's growth limits at step {step_no} "
+                          f"({slid_m * 1e6:.1f} um slid) retired as debris (plough.mpm.strays)")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)
     finally:
@@ -245,11 +251,28 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
             "particle_steps_per_s": active_particle_steps / wall, "threads": numba.get_num_threads(),
             "grid_top_m": float(const.grid_hi[2]), "grid_top_raises": len(state.grid_raises),
             "grid_end_m": float(const.grid_hi[0]), "grid_end_extensions": len(state.grid_extensions),
-            "grid_side_m": float(const.grid_hi[1]), "grid_side_widenings": len(state.grid_widenings)}
-    ds = io.build_dataset(scene, series, slid, state.particles, state.sphere.centre.copy(), cost,
+            "grid_side_m": float(const.grid_hi[1]), "grid_side_widenings": len(state.grid_widenings),
+            "retired_particles": int(state.zone.retired.sum()),
+            "retired_mass_fraction": state.zone.retired_mass_kg / float(state.particles.mass.sum()),
+            "stragglers_frozen": state.zone.stragglers_frozen}
+    ds = io.build_dataset(scene, series, slid, kept_particles(state), state.sphere.centre.copy(), cost,
                           rec.max_penetration, coating_row, slid_distance_m=slid_distance)
     warn_if_unsteady(ds, scene.name)
     return ds
+
+
+def material_top(s: solver.State) -> float:
+    """Height of the highest particle centre, m, but for the debris retired past the grid's limits."""
+    z = s.particles.x[:, 2]
+    return float(z[~s.zone.retired].max()) if s.zone.retired_mass_kg > 0.0 else float(z.max())
+
+
+def kept_particles(s: solver.State) -> Particles:
+    """The particles the outputs read: all but the debris retired past the grid's limits (:mod:`plough.mpm.strays`)."""
+    if s.zone.retired_mass_kg == 0.0:
+        return s.particles
+    keep = ~s.zone.retired
+    return Particles(*(a[keep] for a in s.particles))
 
 
 def warn_if_unsteady(ds: xr.Dataset, name: str) -> None:

@@ -23,8 +23,10 @@ index ranges; the material beyond is frozen and clamps the active part.
 
 Material that rises past the grid's top (a prow that keeps growing), is flung past the block's far end
 (fragments of a soft coating's chip) or thrown out through the side face y = R makes the grid grow there
-mid-run where the scene leaves the headroom automatic (:mod:`plough.mpm.growth`); any other particle
-leaving the grid, and a hand-set headroom, stop the run (:func:`check_stability`).
+mid-run where the scene leaves the headroom automatic (:mod:`plough.mpm.growth`), up to limits past which a
+flung particle is retired as debris; a particle that flows back out of the active zone's trailing slabs is
+frozen where it is (:mod:`plough.mpm.strays`). Any other particle leaving the grid, and a hand-set headroom,
+stop the run (:func:`check_stability`).
 
 The run's constants (:class:`Constants`) are frozen but for the grid, whose growth replaces it
 (:class:`GrowingGrid`); the state (:class:`State`) is everything else that changes.
@@ -177,6 +179,13 @@ class ActiveZone:
     ranges: Zone
     frozen_elastic_J: float = 0.0
     frozen_kinetic_loss_J: float = 0.0
+    #: particles frozen early, behind the zone's trailing slabs (:mod:`plough.mpm.strays`)
+    stragglers_frozen: int = 0
+    #: (n,) the particles retired as debris past the grid's growth limits (frozen; left out of the outputs)
+    retired: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
+    retired_mass_kg: float = 0.0  # their mass (mass-scaled, as stored)
+    #: (step, sliding distance m, particles) of each retirement
+    retired_log: list[tuple[int, float, int]] = field(default_factory=list)
 
 
 @dataclass
@@ -324,6 +333,7 @@ def init(scene: Scene, n_chunks: int | None = None) -> tuple[State, Constants]:
     else:
         zone = ActiveZone(Zone(p_lo=0, p_hi=particles.n, n_lo=0, n_hi=grid.n_nodes, i_free_lo=0,
                                i_free_hi=grid.shape[0], **box))
+    zone.retired = np.zeros(particles.n, dtype=bool)
     state = State(particles=particles, sphere=sphere, work=work, zone=zone)
     update_active_zone(state, const)
     return state, const
