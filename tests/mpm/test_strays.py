@@ -46,8 +46,13 @@ def test_every_per_particle_array_is_permuted(zoned_scene):
     state, const = solver.init(zoned_scene, n_chunks=1)
     n = state.particles.n
     assert n != const.grid.n_nodes
-    per_particle = {name for name, a in vars(state.work).items() if isinstance(a, np.ndarray) and a.shape[:1] == (n,)}
-    assert per_particle == {"v_grid", "last_push_p"}
+    def rows(obj) -> set[str]:
+        return {name for name, a in vars(obj).items() if isinstance(a, np.ndarray) and a.shape[:1] == (n,)}
+
+    assert rows(state.work) == {"v_grid", "last_push_p"}
+    assert rows(const) == {"zone_x0_m"}  # kept sorted by freeze_out_of_order
+    assert rows(state.zone) == {"retired"}  # its slots lie below p_lo, never moved again
+    assert not (rows(state) | rows(state.sphere) | rows(const.growing))
     ids = {id(a) for a in strays.per_particle_arrays(state)}
     assert all(id(a) in ids for a in state.particles)
     assert id(state.work.v_grid) in ids and id(state.work.last_push_p) in ids
@@ -120,28 +125,53 @@ def test_debris_past_more_than_a_thousandth_of_the_mass_stops_the_run_naming_a_p
     assert not state.zone.retired.any() and state.zone.retired_mass_kg == 0.0
 
 
-def test_the_reach_is_where_growth_stops_holding(zoned_scene):
-    """A particle at the reach is held by a growth to the limit (the grid grows); a cell fraction past it is
-    debris (retired)."""
-    for past, retired in ((0.0, False), (0.3, True)):
-        state, const = solver.init(zoned_scene, n_chunks=1)
-        reach = growth.hold_reach(const)[2]
-        assert reach <= const.grid_top_limit_m - const.grid.dx + 1e-12
-        k = state.zone.ranges.p_lo + 5  # an active particle
-        _flag_above_the_top(state, const, index=k)
-        state.particles.x[k, 2] = reach + past * const.grid.dx
+@pytest.mark.parametrize("axis", [0, 1, 2], ids=["far end", "side", "top"])
+def test_a_particle_is_either_held_by_a_growth_or_retired(axis):
+    """A hundredth of a cell inside the farthest a grown grid holds, the grid grows for the particle; a third of
+    a cell past it, the particle is retired and nothing grows. Either way the run goes on (the whole block
+    active: the zone's leading slabs would stop a particle flung past them)."""
+    for past, retired in ((-0.01, False), (0.3, True)):
+        state, const = solver.init(Scene.from_dict(TINY), n_chunks=1)
+        k = state.particles.n - 5  # a particle near the far end
+        far = growth.farthest_held_m(const, axis)
+        assert far <= getattr(const, growth.FACES[axis].limit) - const.grid.dx + 1e-12
+        state.work.acc[:] = 0.0
+        state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
+        state.work.acc[0, transfers.ACC_BAD_INDEX] = k
+        state.particles.x[k, axis] = far + past * const.grid.dx
         end_of_step(state, const)  # no error either way
-        assert bool(state.zone.retired.any()) == retired
-        assert bool(state.grid_raises) != retired
-        assert const.grid_hi[2] <= const.grid_top_limit_m + 1e-12
+        grown = getattr(state, growth.FACES[axis].log)
+        assert bool(state.zone.retired.any()) == retired and bool(grown) != retired
+        assert const.grid_hi[axis] <= getattr(const, growth.FACES[axis].limit) + 1e-12
         if not retired:
-            assert state.particles.x[k, 2] < const.grid_hi[2]
+            assert state.particles.x[k, axis] < const.grid_hi[axis]
+
+
+def test_debris_and_a_straggler_on_one_step_are_both_moved_and_told_apart(zoned_scene):
+    """Debris is retired first (its slot marked), then the straggler frozen (not marked); the run goes on."""
+    state, const = _into_the_slide(zoned_scene)
+    z = state.zone.ranges
+    flung, late = z.p_hi - 3, z.p_lo + 4
+    state.work.acc[:] = 0.0
+    state.work.acc[0, transfers.ACC_BAD] = transfers.BAD_LEFT_GRID
+    state.work.acc[0, transfers.ACC_BAD_INDEX] = late
+    state.particles.x[flung, 2] = const.grid_top_limit_m + const.grid.dx
+    state.particles.x[late, 0] = z.check_lo[0] - 0.2 * const.grid.dx
+    x_flung, x_late = state.particles.x[flung].copy(), state.particles.x[late].copy()
+    end_of_step(state, const)  # no error
+    lo = z.p_lo
+    assert state.zone.ranges.p_lo == lo + 2 and state.zone.stragglers_frozen == 1
+    assert state.zone.retired[lo] and not state.zone.retired[lo + 1] and state.zone.retired.sum() == 1
+    assert np.array_equal(state.particles.x[lo], x_flung) and np.array_equal(state.particles.x[lo + 1], x_late)
+    for _ in range(20):
+        solver.step(state, const)
 
 
 def test_a_retired_particle_leaves_the_material_top_and_the_outputs(zoned_scene):
     state, const = solver.init(zoned_scene, n_chunks=1)
     _flag_above_the_top(state, const, index=state.zone.ranges.p_lo + 5, over_m=const.grid_top_limit_m)
     top_with = float(state.particles.x[:, 2].max())
+    assert run_module.material_top(state) == top_with  # debris counts until it is retired
     end_of_step(state, const)
     assert state.zone.retired.sum() == 1
     assert run_module.material_top(state) < top_with

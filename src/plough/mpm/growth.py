@@ -102,8 +102,8 @@ def grow_to_hold(s: State, c: Constants) -> None:
 
 
 def hold(s: State, c: Constants, index: int) -> int:
-    """Settle the strays (:func:`plough.mpm.strays.settle`: stragglers behind the active zone frozen, debris past
-    the growth limits retired), then grow every face of :data:`FACES` the active particles passed as far as they
+    """Settle the strays (:func:`plough.mpm.strays.settle`: debris past the growth limits retired, stragglers
+    behind the active zone frozen), then grow every face of :data:`FACES` the active particles passed as far as they
     need and the limits allow; the particle still outside afterwards (``index``, the one flagged, where nothing
     moved or grew), -1 if none.
 
@@ -111,7 +111,7 @@ def hold(s: State, c: Constants, index: int) -> int:
     growths that follow it (:func:`grow_face`). Nothing grows where a particle is outside for a reason no
     growth mends (:func:`_outside_for_good`) or past a face that cannot grow as far as it needs: that
     particle is the one named (the far end's first, then the side's, then the top's)."""
-    moved = strays.settle(s, c, hold_reach(c))  # stragglers behind the zone frozen, debris past the limits retired
+    moved = strays.settle(s, c, beyond_reach(s, c))  # debris past the limits retired, stragglers behind the zone frozen
     stuck = _outside_for_good(s, c)
     if stuck >= 0:
         return stuck
@@ -161,18 +161,33 @@ def grow_face(s: State, c: Constants, axis: int, then: tuple[tuple[int, int], ..
     return True
 
 
-def hold_reach(c: Constants) -> dict[int, float]:
-    """The farthest a particle may be along each growing face's axis for the grid grown to the face's limit to
-    hold it (a cell of room past it, whole node layers: as :func:`_layers_past` counts), m; the faces that do
-    not grow (a hand-set headroom) left out."""
-    reach = {}
+def _allowed_layers(limit_m: float, now_m: float, dx: float) -> int:
+    """Whole node layers a face at ``now_m`` may still grow by before it passes ``limit_m``."""
+    return max(math.floor((limit_m - now_m) / dx + 1e-9), 0)
+
+
+def farthest_held_m(c: Constants, axis: int) -> float:
+    """The farthest a particle may be along ``axis`` for the grid grown to its face's limit to hold it (a cell of
+    room past it, in whole node layers, as :func:`_layers_past` counts), m."""
+    now, dx = float(c.grid_hi[axis]), c.grid.dx
+    return now + (_allowed_layers(getattr(c, FACES[axis].limit), now, dx) - 1) * dx
+
+
+def beyond_reach(s: State, c: Constants) -> np.ndarray:
+    """The active particles no growth can hold, as indices: past the grid's interior along a growing face's axis
+    by more node layers than the face may still grow (the arithmetic of :func:`_layers_past`, so that a particle
+    is either held or beyond reach); none along a face that does not grow (a hand-set headroom)."""
+    z = s.zone.ranges
+    x = s.particles.x[z.p_lo:z.p_hi]
+    dx = c.grid.dx
+    past = np.zeros(len(x), dtype=bool)
     for axis, face in FACES.items():
         limit_m = getattr(c, face.limit)
         if limit_m > 0.0:
-            now, dx = float(c.grid_hi[axis]), c.grid.dx
-            allowed = max(math.floor((limit_m - now) / dx + 1e-9), 0)
-            reach[axis] = now + (allowed - 1 + 1e-9) * dx
-    return reach
+            now = float(c.grid_hi[axis])
+            xa = x[:, axis]
+            past |= (xa > now) & (np.ceil((xa + dx - now) / dx - 1e-9) > _allowed_layers(limit_m, now, dx))
+    return z.p_lo + np.flatnonzero(past)
 
 
 def _outside_for_good(s: State, c: Constants) -> int:
@@ -208,7 +223,7 @@ def _layers_past(s: State, c: Constants, axis: int) -> int:
     if far <= now:
         return 0
     need = max(_layers_to(far + c.grid.dx, now, c.grid.dx), 1)
-    return need if need <= math.floor((limit_m - now) / c.grid.dx + 1e-9) else 0
+    return need if need <= _allowed_layers(limit_m, now, c.grid.dx) else 0
 
 
 def _layers_to(target_m: float, now_m: float, dx: float) -> int:

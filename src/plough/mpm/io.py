@@ -43,7 +43,8 @@ SERIES_META = {
     "depth": ("m", "depth of the sphere's lowest point below the original surface"),
     "particle_penetration": ("m", "deepest penetration of a particle centre into the sphere"),
     "contact_area_xy": ("m2", "contact area projected on the sliding plane"),
-    "material_top": ("m", "height of the highest particle centre above the original surface (pile-up, prow)"),
+    "material_top": ("m", "height of the highest particle centre above the original surface (pile-up, prow; "
+                          "debris counts until it is retired past the grid's growth limits)"),
     "external_work": ("J", "work done by the sphere on the block (cumulative)"),
     "plastic_work": ("J", "plastic work (cumulative)"),
     "elastic_energy": ("J", "elastic strain energy"),

@@ -192,6 +192,7 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
     slid_distance = scene.sliding.distance_m
     active_particle_steps = 0
     raises_told = extensions_told = widenings_told = retired_told = 0
+    stragglers_told = False
     try:
         while state.sphere.phase != "done":
             solver.step(state, const)
@@ -231,6 +232,11 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
                 step_no, slid_m, count = state.zone.retired_log[-1]
                 bar.write(f"{scene.name}: {count} particle(s) flung past the grid's growth limits at step {step_no} "
                           f"({slid_m * 1e6:.1f} um slid) retired as debris (plough.mpm.strays)")
+            if bar is not None and state.zone.stragglers_frozen and not stragglers_told:
+                stragglers_told = True
+                bar.write(f"{scene.name}: material flowed back out of the active zone's trailing slabs at step "
+                          f"{state.step} ({state.sphere.slid_m * 1e6:.1f} um slid); frozen where it is (plough.mpm."
+                          "strays; the count in cost_stragglers_frozen)")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)
     finally:

@@ -181,7 +181,8 @@ class ActiveZone:
     frozen_kinetic_loss_J: float = 0.0
     #: particles frozen early, behind the zone's trailing slabs (:mod:`plough.mpm.strays`)
     stragglers_frozen: int = 0
-    #: (n,) the particles retired as debris past the grid's growth limits (frozen; left out of the outputs)
+    #: (n,) the particles retired as debris past the grid's growth limits (frozen; left out of the groove, the
+    #: pictures and material_top; snapshots show them)
     retired: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=bool))
     retired_mass_kg: float = 0.0  # their mass (mass-scaled, as stored)
     #: (step, sliding distance m, particles) of each retirement

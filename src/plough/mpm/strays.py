@@ -3,18 +3,21 @@ and the growing grid").
 
 Two kinds, both answered after the step's kernels, before the grid grows (:func:`plough.mpm.growth.hold`):
 
+* **Debris** past a growing face's reach (automatic headroom only): a particle the grid cannot grow to hold
+  (``growth.beyond_reach``: within a cell or two of the face's limit, ``growth.GRID_TOP_LIMIT_RADII`` sphere
+  radii above the original surface, the sphere's own top, or as many radii past the far end or the side) is
+  a fragment in free flight far from the contact (the 1e6 mass scaling flings surface fragments of a hard
+  thin coating at about the sliding speed). It is retired: frozen where it is, left out of the groove, the
+  pictures and, from then on, the material's top (snapshots still show it), counted
+  (``cost_retired_particles``, ``cost_retired_mass_fraction``) with its kinetic energy in
+  ``frozen_kinetic_loss``. More than :data:`RETIRED_MASS_FRACTION_MAX` of the block's mass past the limits is
+  not debris but a prow or a chip the grid cannot hold: the run stops.
 * **Stragglers** behind the active zone: a particle that moved back out of the zone's trailing grid slabs
   (the slabs the zone has retired). The zone freezes material by its initial position; a particle that
-  flowed back more than the slabs' pad (``solver.ZONE_PAD_CELLS`` less a stencil) is frozen where it is, as
-  the zone would freeze it a few steps later, its kinetic energy counted as the zone's freezing counts it.
-* **Debris** past a growing face's limit (automatic headroom only): a particle flung more than
-  ``growth.GRID_TOP_LIMIT_RADII`` sphere radii above the original surface (the sphere's own top), past the
-  far end or past the side by as many radii, is a fragment in free flight far from the contact (the 1e6
-  mass scaling flings surface fragments of a hard thin coating at about the sliding speed). It is retired:
-  frozen where it is, left out of the groove and the material's top, counted (``cost_retired_particles``,
-  ``cost_retired_mass_fraction``) with its kinetic energy in ``frozen_kinetic_loss``. More than
-  :data:`RETIRED_MASS_FRACTION_MAX` of the block's mass past the limits is not debris but a prow or a chip
-  the grid cannot hold: the run stops.
+  flowed back more than the slabs' pad (``solver.ZONE_PAD_CELLS`` less a stencil) is frozen where it is,
+  as the zone freezes the material around it (by initial position, so sooner or later), its kinetic energy
+  counted as the zone's freezing counts it (``cost_stragglers_frozen``). Debris is settled first: a particle
+  both behind the zone and beyond reach is retired.
 
 Both move the particles to the frozen range: the particles are stored x-major by initial position and the
 zone works on the index range [p_lo, p_hi) (``solver.ActiveZone``), so a particle leaves it by a stable
@@ -87,45 +90,35 @@ def stragglers(s: State) -> np.ndarray:
     return z.p_lo + np.flatnonzero(x < z.check_lo[0])
 
 
-def debris(s: State, c: Constants, reach: dict[int, float]) -> np.ndarray:
-    """Active particles the grid cannot grow to hold, as indices: past the grid's interior along a growing
-    face's axis and past ``reach[axis]``, the farthest a particle may be for the grid grown to the face's limit
-    to hold it (``growth.hold_reach``); none along an axis ``reach`` leaves out (a face that does not grow)."""
-    z = s.zone.ranges
-    x = s.particles.x[z.p_lo:z.p_hi]
-    past = np.zeros(len(x), dtype=bool)
-    for axis, far_m in reach.items():
-        past |= (x[:, axis] > c.grid_hi[axis]) & (x[:, axis] > far_m)
-    return z.p_lo + np.flatnonzero(past)
-
-
-def settle(s: State, c: Constants, reach: dict[int, float]) -> int:
-    """Freeze the stragglers and retire the debris (:func:`debris` with ``reach``) of this step (the module
-    docstring); the number of particles moved to the frozen range. Stops the run where the debris passes
-    :data:`RETIRED_MASS_FRACTION_MAX` of the block's mass."""
+def settle(s: State, c: Constants, flung: np.ndarray) -> int:
+    """Retire the debris ``flung`` (the active particles no growth can hold: ``growth.beyond_reach``), then freeze
+    the stragglers (:func:`stragglers`) of this step (the module docstring); the number of particles moved to the
+    frozen range. Stops the run, retiring nothing, where the debris would pass :data:`RETIRED_MASS_FRACTION_MAX`
+    of the block's mass."""
+    moved = 0
+    if flung.size:
+        mass = s.particles.mass
+        share = (s.zone.retired_mass_kg + float(mass[flung].sum())) / float(mass.sum())
+        if share > RETIRED_MASS_FRACTION_MAX:
+            raise InstabilityError(
+                f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material past the "
+                f"grid's growth limits ({c.grid_top_limit_m * 1e6:.1f} um above the surface, x "
+                f"{c.grid_end_limit_m * 1e6:.1f} um, y {c.grid_side_limit_m * 1e6:.1f} um) would make {share:.2%} "
+                f"of the block's mass, more than the {RETIRED_MASS_FRACTION_MAX:.1%} retired as flung fragments: a "
+                "prow or chip the grid cannot hold (coarser particles, a lower load, or a hand-set domain.headroom_m)")
+        s.zone.retired_mass_kg += float(mass[flung].sum())
+        slots_from = s.zone.ranges.p_lo
+        elastic, kinetic = freeze_out_of_order(s, c, flung)
+        s.zone.retired[slots_from:slots_from + flung.size] = True
+        s.zone.frozen_elastic_J += elastic
+        s.zone.frozen_kinetic_loss_J += kinetic
+        s.zone.retired_log.append((s.step, s.sphere.slid_m, int(flung.size)))
+        moved += int(flung.size)
     late = stragglers(s)
     if late.size:
         elastic, kinetic = freeze_out_of_order(s, c, late)
         s.zone.frozen_elastic_J += elastic
         s.zone.frozen_kinetic_loss_J += kinetic
-        s.zone.stragglers_frozen += late.size
-    flung = debris(s, c, reach)
-    if not flung.size:
-        return int(late.size)
-    mass = s.particles.mass
-    share = (s.zone.retired_mass_kg + float(mass[flung].sum())) / float(mass.sum())
-    if share > RETIRED_MASS_FRACTION_MAX:
-        raise InstabilityError(
-            f"unstable run at step {s.step} (sliding distance {s.sphere.slid_m * 1e6:.1f} um): material past the "
-            f"grid's growth limits ({c.grid_top_limit_m * 1e6:.1f} um above the surface, x "
-            f"{c.grid_end_limit_m * 1e6:.1f} um, y {c.grid_side_limit_m * 1e6:.1f} um) would make {share:.2%} of "
-            f"the block's mass, more than the {RETIRED_MASS_FRACTION_MAX:.1%} retired as flung fragments: a prow "
-            "or chip the grid cannot hold (coarser particles, a lower load, or a hand-set domain.headroom_m)")
-    s.zone.retired_mass_kg += float(mass[flung].sum())
-    slots_from = s.zone.ranges.p_lo
-    elastic, kinetic = freeze_out_of_order(s, c, flung)
-    s.zone.retired[slots_from:slots_from + flung.size] = True
-    s.zone.frozen_elastic_J += elastic
-    s.zone.frozen_kinetic_loss_J += kinetic
-    s.zone.retired_log.append((s.step, s.sphere.slid_m, int(flung.size)))
-    return int(late.size + flung.size)
+        s.zone.stragglers_frozen += int(late.size)
+        moved += int(late.size)
+    return moved
