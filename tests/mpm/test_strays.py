@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from dataclasses import replace
 
-import numba
 import numpy as np
 import pytest
 
@@ -13,15 +12,12 @@ from plough.mpm import run as run_module
 from plough.mpm import scene as scene_module
 from plough.mpm.scene import Scene
 
-from .test_run_small import TINY, _flag_above_the_top, end_of_step
-
-
-@pytest.fixture(scope="module", autouse=True)
-def single_thread():
-    old = numba.get_num_threads()
-    numba.set_num_threads(1)
-    yield
-    numba.set_num_threads(old)
+from .test_run_small import (
+    TINY,
+    _flag_above_the_top,
+    end_of_step,
+    single_thread,  # noqa: F401 - autouse: deterministic, cheap single-threaded runs
+)
 
 
 @pytest.fixture
