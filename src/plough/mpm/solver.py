@@ -530,24 +530,20 @@ def check_stability(s: State, c: Constants) -> None:
     if bad != transfers.BAD_NONE:
         cause = CAUSES[bad]
         if bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]:
-            limit = (f"; the automatic headroom stops at {GRID_TOP_LIMIT_RADII:g} sphere radii, "
-                     f"{c.grid_top_limit_m * 1e6:.1f} um" if c.grid_top_limit_m > 0.0 else "")
             cause = (f"a particle rose above the grid's top (z = {c.grid_hi[2] * 1e6:.1f} um over the original "
                      "surface): material the sphere pushes up (a growing prow: set domain.headroom_m higher) or a "
-                     f"particle flung off the surface (lower mass_scaling or speed){limit}")
+                     f"particle flung off the surface (lower mass_scaling or speed)")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 0] > c.grid_hi[0]:
             ahead = (s.particles.x[index, 0] - s.sphere.centre[0]) * 1e6
-            limit = _growth_limit_note("lengthens past the block's end", GRID_END_LIMIT_RADII, "x", c.grid_end_limit_m)
             cause = (f"a particle moved past the grid's far end (x = {c.grid_hi[0] * 1e6:.1f} um; the block ends at "
                      f"{c.block_end_m * 1e6:.1f} um), {ahead:.1f} um ahead of the sphere's centre: material the sphere "
                      "pushes ahead of it (a prow or chip of a soft coating: lengthen domain.length_m) or a particle "
-                     f"flung off the surface (lower mass_scaling or speed){limit}")
+                     "flung off the surface (lower mass_scaling or speed)")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 1] > c.grid_hi[1]:
-            limit = _growth_limit_note("widens past the block's side", GRID_SIDE_LIMIT_RADII, "y", c.grid_side_limit_m)
             cause = (f"a particle moved out through the grid's side (y = {c.grid_hi[1] * 1e6:.1f} um; the block's "
                      f"side is at {c.block_side_m * 1e6:.1f} um): material the sphere throws sideways (a prow or "
                      "chip of a soft coating: enlarge domain.radius_m) or a particle flung off the surface (lower "
-                     f"mass_scaling or speed){limit}")
+                     "mass_scaling or speed)")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and _left_zone(s, c, s.particles.x[index, 0]):
             zone = s.zone.ranges
             cause = (f"a particle moved out of the active zone's grid slabs (x {zone.check_lo[0] * 1e6:.1f}.."
@@ -561,13 +557,6 @@ def check_stability(s: State, c: Constants) -> None:
         raise InstabilityError(f"unstable run {where}: kinetic energy {kinetic:.3g} J exceeds twice the work done "
                               f"by the sphere ({s.work.external_work:.3g} J): inertia dominates; lower "
                               "discretisation.mass_scaling or sliding.speed_m_s, or the time step (cfl)")
-
-
-def _growth_limit_note(what: str, radii: float, axis_name: str, limit_m: float) -> str:
-    """'; the grid <what> by <radii> sphere radii at most, to <axis> = <limit> um', or '' for a fixed grid."""
-    if limit_m <= 0.0:
-        return ""
-    return f"; the grid {what} by {radii:g} sphere radii at most, to {axis_name} = {limit_m * 1e6:.1f} um"
 
 
 def _left_zone(s: State, c: Constants, x: float) -> bool:

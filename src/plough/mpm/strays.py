@@ -43,6 +43,7 @@ if TYPE_CHECKING:
 #: a few particles; material past the limits beyond this share is a prow or chip the grid cannot hold
 RETIRED_MASS_FRACTION_MAX = 1e-3
 
+
 def per_particle_arrays(s: State) -> list[np.ndarray]:
     """Every array with a row per particle that the run keeps: the particle bundle's fields, the grid velocity
     each particle was advected with and the particle contact's memory (``solver.Work``)."""
@@ -80,6 +81,13 @@ def freeze_out_of_order(s: State, c: Constants, indices: np.ndarray) -> tuple[fl
     return elastic, kinetic
 
 
+def _freeze_and_count(s: State, c: Constants, indices: np.ndarray) -> None:
+    """:func:`freeze_out_of_order`, its energies counted as the zone counts those of the particles it freezes."""
+    elastic, kinetic = freeze_out_of_order(s, c, indices)
+    s.zone.frozen_elastic_J += elastic
+    s.zone.frozen_kinetic_loss_J += kinetic
+
+
 def stragglers(s: State) -> np.ndarray:
     """Active particles behind the zone's trailing slabs (x below the positions check's low end where the
     zone has retired slabs there), as indices."""
@@ -108,17 +116,13 @@ def settle(s: State, c: Constants, flung: np.ndarray) -> int:
                 "prow or chip the grid cannot hold (coarser particles, a lower load, or a hand-set domain.headroom_m)")
         s.zone.retired_mass_kg += float(mass[flung].sum())
         slots_from = s.zone.ranges.p_lo
-        elastic, kinetic = freeze_out_of_order(s, c, flung)
+        _freeze_and_count(s, c, flung)
         s.zone.retired[slots_from:slots_from + flung.size] = True
-        s.zone.frozen_elastic_J += elastic
-        s.zone.frozen_kinetic_loss_J += kinetic
         s.zone.retired_log.append((s.step, s.sphere.slid_m, int(flung.size)))
         moved += int(flung.size)
     late = stragglers(s)
     if late.size:
-        elastic, kinetic = freeze_out_of_order(s, c, late)
-        s.zone.frozen_elastic_J += elastic
-        s.zone.frozen_kinetic_loss_J += kinetic
+        _freeze_and_count(s, c, late)
         s.zone.stragglers_frozen += int(late.size)
         moved += int(late.size)
     return moved
