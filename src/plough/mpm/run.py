@@ -8,6 +8,7 @@ from __future__ import annotations
 
 import numbers
 import os
+import sys
 import time
 import warnings
 from collections.abc import Callable
@@ -215,28 +216,28 @@ def simulate(scene: Scene, *, progress: bool = True, snapshots_dir: str | Path |
             if bar is not None and len(state.grid_raises) > raises_told:
                 raises_told = len(state.grid_raises)
                 step_no, slid_m, top_m = state.grid_raises[-1]
-                bar.write(f"{scene.name}: material reached the grid's top at step {step_no} ({slid_m * 1e6:.1f} um "
-                          f"slid); the grid's top raised to {top_m * 1e6:.1f} um above the original surface")
+                _tell(bar, f"{scene.name}: material reached the grid's top at step {step_no} ({slid_m * 1e6:.1f} um "
+                           f"slid); the grid's top raised to {top_m * 1e6:.1f} um above the original surface")
             if bar is not None and len(state.grid_extensions) > extensions_told:
                 extensions_told = len(state.grid_extensions)
                 step_no, slid_m, end_m = state.grid_extensions[-1]
-                bar.write(f"{scene.name}: material passed the grid's far end at step {step_no} ({slid_m * 1e6:.1f} "
-                          f"um slid); the grid lengthened to x = {end_m * 1e6:.1f} um")
+                _tell(bar, f"{scene.name}: material passed the grid's far end at step {step_no} ({slid_m * 1e6:.1f} "
+                           f"um slid); the grid lengthened to x = {end_m * 1e6:.1f} um")
             if bar is not None and len(state.grid_widenings) > widenings_told:
                 widenings_told = len(state.grid_widenings)
                 step_no, slid_m, side_m = state.grid_widenings[-1]
-                bar.write(f"{scene.name}: material passed the grid's side at step {step_no} ({slid_m * 1e6:.1f} "
-                          f"um slid); the grid widened to y = {side_m * 1e6:.1f} um")
+                _tell(bar, f"{scene.name}: material passed the grid's side at step {step_no} ({slid_m * 1e6:.1f} "
+                           f"um slid); the grid widened to y = {side_m * 1e6:.1f} um")
             if bar is not None and len(state.zone.retired_log) > retired_told:
                 retired_told = len(state.zone.retired_log)
                 step_no, slid_m, count = state.zone.retired_log[-1]
-                bar.write(f"{scene.name}: {count} particle(s) flung past the grid's growth limits at step {step_no} "
-                          f"({slid_m * 1e6:.1f} um slid) retired as debris (plough.mpm.strays)")
+                _tell(bar, f"{scene.name}: {count} particle(s) flung past the grid's growth limits at step {step_no} "
+                           f"({slid_m * 1e6:.1f} um slid) retired as debris (plough.mpm.strays)")
             if bar is not None and state.zone.stragglers_frozen and not stragglers_told:
                 stragglers_told = True
-                bar.write(f"{scene.name}: material flowed back out of the active zone's trailing slabs at step "
-                          f"{state.step} ({state.sphere.slid_m * 1e6:.1f} um slid); frozen where it is (plough.mpm."
-                          "strays; the count in cost_stragglers_frozen)")
+                _tell(bar, f"{scene.name}: material flowed back out of the active zone's trailing slabs at step "
+                           f"{state.step} ({state.sphere.slid_m * 1e6:.1f} um slid); frozen where it is (plough.mpm."
+                           "strays; the count in cost_stragglers_frozen)")
             if bar is not None and state.step % 20 == 0:
                 _update_bar(bar, state, rec)
     finally:
@@ -297,6 +298,12 @@ def _progress(scene: Scene, enabled: bool):
 
     return tqdm(total=round(scene.sliding.distance_m * 1e6, 1), unit="um", desc=f"{scene.name}: pressing",
                 bar_format="{desc} |{bar}| {n:.0f}/{total:.0f} um slid [{elapsed}<{remaining}] {postfix}")
+
+
+def _tell(bar, message: str) -> None:
+    """One line above the progress bar, on standard error with the bar (tqdm writes to standard output by default,
+    which the workflow does not keep in the run's log)."""
+    bar.write(message, file=sys.stderr)
 
 
 def _update_bar(bar, state: solver.State, rec: _Recorder) -> None:
