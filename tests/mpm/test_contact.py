@@ -239,18 +239,38 @@ def test_tangential_impulse_is_traction_limited_and_never_reverses(model, iparam
 
 @pytest.mark.parametrize("model,iparams", MODELS)
 def test_energy_account_of_contact(model, iparams):
-    """Kinetic energy change = work of the sphere - interface dissipation - normal impact loss."""
+    """The contact's losses are powers at the end-of-step relative velocity: friction times the slip left
+    (interface dissipation) and each push times the approach left (impact loss, jn gap / dt where a particle
+    face is a gap away). The node's kinetic-energy change is the sphere's work minus those minus |J|^2 / 2m
+    per node, the velocity this step's internal force gave and the push took back (the stress power counts
+    it); the identity checks all three terms at once."""
     case = make_case(40 + model)
-    _, contact, _, vn, _ = classify(case)
+    rng = np.random.default_rng(7)
+    touching = case["cbuf"][:, 8] > 0
+    half = touching & (rng.random(N_NODES) < 0.5)
+    case["cbuf"][half, 8] = DX * rng.uniform(0.2, 0.9, half.sum())  # a gap of 0.1-0.8 DX: the push term
+    gap = np.maximum(DX - case["cbuf"][:, 8], 0.0)
+    inside, _, n, vn, _ = classify(case)
+    pushed = inside & (case["grid_m"] > 0) & touching & (vn < -gap / DT)
     grid_v, _, out = call(case, model, iparams)
-    m = case["grid_m"]
-    dke = 0.5 * (m * ((grid_v**2).sum(1) - (case["grid_v"] ** 2).sum(1))).sum()
-    work = (m[:, None] * (grid_v - case["grid_v"]) @ case["v_sphere"]).sum()
+    m, v0, vs = case["grid_m"], case["grid_v"], case["v_sphere"]
+    J = m[:, None] * (grid_v - v0)
+    jn = (J * n).sum(1)
+    np.testing.assert_allclose(jn[pushed], m[pushed] * (-gap[pushed] / DT - vn[pushed]), rtol=1e-9)
+    rel_after = grid_v - vs
+    assert out[ct.OUT_IMPACT] == pytest.approx((jn[pushed] * gap[pushed] / DT).sum(), rel=1e-10)
+    assert (gap[pushed] > 0).sum() >= 5 and out[ct.OUT_IMPACT] > 0.0  # the case pushes nodes a gap away
+    jt_vec = J - jn[:, None] * n
+    slip_after = rel_after - (rel_after * n).sum(1)[:, None] * n
+    dissipation = np.linalg.norm(jt_vec, axis=1) * np.linalg.norm(slip_after, axis=1)
+    assert out[ct.OUT_DISSIPATION] == pytest.approx(dissipation[inside].sum(), rel=1e-9)
+    dke = 0.5 * (m * ((grid_v**2).sum(1) - (v0**2).sum(1))).sum()
+    work = (J @ vs).sum()
     assert out[ct.OUT_WORK] == pytest.approx(work, rel=1e-10)
-    assert out[ct.OUT_IMPACT] == pytest.approx(0.5 * (m[contact] * vn[contact] ** 2).sum(), rel=1e-12)
-    assert out[ct.OUT_DISSIPATION] >= 0.0
-    scale = 0.5 * (m * (case["grid_v"] ** 2).sum(1)).sum()
-    assert dke == pytest.approx(out[ct.OUT_WORK] - out[ct.OUT_DISSIPATION] - out[ct.OUT_IMPACT], abs=1e-10 * scale)
+    taken_back = (np.where(m > 0, (J**2).sum(1) / (2 * np.where(m > 0, m, 1.0)), 0.0)).sum()
+    scale = 0.5 * (m * (v0**2).sum(1)).sum()
+    assert dke == pytest.approx(out[ct.OUT_WORK] - out[ct.OUT_DISSIPATION] - out[ct.OUT_IMPACT] - taken_back,
+                                abs=1e-10 * scale)
 
 
 def test_contact_buffer_is_consumed_where_the_contact_looks_only():

@@ -65,8 +65,8 @@ NEVER_PUSHED = -(2**62)
 # outputs of sphere_contact
 OUT_FN = 0  # 0:3 force on the sphere from normal impulses, N
 OUT_FT = 3  # 3:6 force on the sphere from tangential (interface) impulses, N
-OUT_DISSIPATION = 6  # energy dissipated by interface slip in this step, J
-OUT_IMPACT = 7  # kinetic energy lost by the inelastic normal projection, J
+OUT_DISSIPATION = 6  # energy dissipated by interface slip in this step (friction times end-of-step slip), J
+OUT_IMPACT = 7  # work of the normal pushes against the end-of-step approach of the nodes in this step, J
 OUT_WORK = 8  # work done by the sphere on the material this step, J
 OUT_NODES = 9  # number of contact nodes
 OUT_AREA_XY = 10  # contact area projected on the xy plane, m^2
@@ -374,8 +374,13 @@ def sphere_contact(G, S, law, step, dt, out):
                     out[OUT_FT + 1] += jt * t1 / vt / dt
                     out[OUT_FT + 2] += jt * t2 / vt / dt
                 vt_after = scale * vt
-                out[OUT_DISSIPATION] += 0.5 * jt * (vt + vt_after)
-                out[OUT_IMPACT] += 0.5 * jn * jn / m
+                # the contact's losses at the end-of-step relative velocity, as the stress power takes the
+                # end-of-step velocity gradient: friction times slip, and a push on a node that still approaches
+                # (vn_after = vn_min < 0 where jn > 0). The rest of the node's kinetic-energy change, |J|^2 / 2m,
+                # is the velocity this step's internal force gave the node and the push took back: work the stress
+                # power already counts (docs/journal/2026-12-02-cfl.md)
+                out[OUT_DISSIPATION] += jt * vt_after
+                out[OUT_IMPACT] -= jn * vn_after
                 out[OUT_WORK] += m * ((va0 - vb0) * v_sphere[0] + (va1 - vb1) * v_sphere[1]
                                       + (va2 - vb2) * v_sphere[2])
                 out[OUT_NODES] += 1.0

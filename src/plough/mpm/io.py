@@ -49,8 +49,10 @@ SERIES_META = {
     "plastic_work": ("J", "plastic work (cumulative)"),
     "elastic_energy": ("J", "elastic strain energy"),
     "kinetic_energy": ("J", "kinetic energy (mass-scaled)"),
-    "interface_dissipation": ("J", "energy dissipated by interface slip (cumulative)"),
-    "contact_impact_loss": ("J", "kinetic energy lost in the inelastic normal contact projection (cumulative)"),
+    "interface_dissipation": ("J", "energy dissipated by interface slip: friction impulse times the slip left "
+                                     "(cumulative)"),
+    "contact_impact_loss": ("J", "work of the normal contact pushes against the approach left, jn gap / dt "
+                                   "(cumulative)"),
     "frozen_kinetic_loss": ("J", "kinetic energy of the particles frozen as the active zone left them, or retired "
                                  "as debris past the grid's growth limits (cumulative; plough.mpm.strays)"),
     "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),
