@@ -242,8 +242,8 @@ def test_energy_account_of_contact(model, iparams):
     """The contact's losses are powers at the end-of-step relative velocity: friction times the slip left
     (interface dissipation) and each push times the approach left (impact loss, jn gap / dt where a particle
     face is a gap away). The node's kinetic-energy change is the sphere's work minus those minus |J|^2 / 2m
-    per node, the velocity this step's internal force gave and the push took back (the stress power counts
-    it); the identity checks all three terms at once."""
+    per node (in a lasting contact the velocity this step's internal force gave and the push took back, no
+    loss: docs/journal/2026-12-02-cfl.md); the identity checks all three terms at once."""
     case = make_case(40 + model)
     rng = np.random.default_rng(7)
     touching = case["cbuf"][:, 8] > 0

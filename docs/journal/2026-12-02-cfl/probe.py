@@ -1,8 +1,8 @@
 """What a larger time step costs in accuracy: the workflow's scenes at CFL 0.3 / 0.45 / 0.6, each at a few
 lattice phases (journal 2026-12-02-cfl.md).
 
-    python docs/journal/2026-12-02-cfl/probe.py --cases uncoated:10:1 coated:10:1 coated:10:0.5 real:20 \
-        --cfl 0.3 0.45 0.6 --phases 3 --out docs/journal/2026-12-02-cfl/cfl.json
+    python docs/journal/2026-12-02-cfl/probe.py --cases uncoated:10:1 coated:10:1 coated:10:0.5 uncoated:10:0.5 \
+        real:20 --cfl 0.15 0.3 0.45 0.6 --phases 3 --out docs/journal/2026-12-02-cfl/cfl.json
 
 A case is scene:h_um[:f] (``common.EXAMPLES``; f overrides the proportional interface's f). Each run uses the
 workflow's numerics (``common.workflow_scene`` with the fine zone as deep as config/config.yaml makes it) and

@@ -376,9 +376,10 @@ def sphere_contact(G, S, law, step, dt, out):
                 vt_after = scale * vt
                 # the contact's losses at the end-of-step relative velocity, as the stress power takes the
                 # end-of-step velocity gradient: friction times slip, and a push on a node that still approaches
-                # (vn_after = vn_min < 0 where jn > 0). The rest of the node's kinetic-energy change, |J|^2 / 2m,
-                # is the velocity this step's internal force gave the node and the push took back: work the stress
-                # power already counts (docs/journal/2026-12-02-cfl.md)
+                # (vn_after = vn_min <= 0 where jn > 0). The node's kinetic-energy change is the work less these
+                # less |J|^2 / 2m; the step leaves |F + J|^2 / 2m (F the internal force's impulse) unaccounted,
+                # about 0 in a lasting contact where the push takes back what F gave, a real loss where a node
+                # arrives approaching (docs/journal/2026-12-02-cfl.md)
                 out[OUT_DISSIPATION] += jt * vt_after
                 out[OUT_IMPACT] -= jn * vn_after
                 out[OUT_WORK] += m * ((va0 - vb0) * v_sphere[0] + (va1 - vb1) * v_sphere[1]

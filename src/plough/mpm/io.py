@@ -50,9 +50,11 @@ SERIES_META = {
     "elastic_energy": ("J", "elastic strain energy"),
     "kinetic_energy": ("J", "kinetic energy (mass-scaled)"),
     "interface_dissipation": ("J", "energy dissipated by interface slip: friction impulse times the slip left "
-                                     "(cumulative)"),
+                                     "(grid contact; particle contact: the tangential impulses' work less the "
+                                     "nodes' kinetic-energy gain) (cumulative)"),
     "contact_impact_loss": ("J", "work of the normal contact pushes against the approach left, jn gap / dt "
-                                   "(cumulative)"),
+                                   "(grid contact; particle contact: the normal impulses' work less the nodes' "
+                                   "kinetic-energy gain) (cumulative)"),
     "frozen_kinetic_loss": ("J", "kinetic energy of the particles frozen as the active zone left them, or retired "
                                  "as debris past the grid's growth limits (cumulative; plough.mpm.strays)"),
     "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),

@@ -459,7 +459,7 @@ def elastic_energy(s: State, c: Constants) -> float:
 
 def account_energy(w: Work) -> None:
     out = w.contact_out
-    # sphere power x dt = work on the material + interface slip loss + inelastic normal impact loss
+    # sphere power x dt = work on the material + interface slip loss + normal push loss (contact.OUT_*)
     w.external_work += float(out[contact.OUT_WORK])
     w.interface_dissipation += float(out[contact.OUT_DISSIPATION])
     w.contact_impact_loss += float(out[contact.OUT_IMPACT])
