@@ -47,14 +47,16 @@ def assert_bounded(s: Scene, *, energy: bool) -> None:
 
 
 def test_cfl_at_the_accepted_maximum_completes_bounded_with_the_energy_balance():
-    """CFL 0.6, the accepted maximum (CFL_MAX): measured mu 0.451, Fz / load 1.18, energy terms 1.11 x
-    the work, against 0.485 / 0.91 / 1.03 at CFL 0.3. Above it the load is lost (1.23 at 0.8)."""
+    """CFL 0.6, the accepted maximum (CFL_MAX): measured mu 0.451, Fz / load 1.18, energy terms 0.951 x
+    the work, against 0.485 / 0.91 / 0.952 at CFL 0.3 (benchmarks/stability_matrix.py, 2026-12-02). Above it the
+    load is lost (1.23 at 0.8)."""
     assert CFL_MAX == 0.6
     assert_bounded(scene(discretisation={"cfl": CFL_MAX}), energy=True)
 
 
 def test_bulk_coating_200_um_completes_bounded():
-    """t = 200 um, H~ = 0.5: the sphere never reaches the substrate (measured mu 0.448, energy 1.02)."""
+    """t = 200 um, H~ = 0.5: the sphere never reaches the substrate (measured mu 0.452, energy 0.957 in
+    benchmarks/stability_matrix.py, 2026-12-02)."""
     assert_bounded(scene(layers={"coating_thickness_um": 200, "coating": {"rigid_plastic_hardness_MPa": 450},
                                  "substrate": {"rigid_plastic_hardness_MPa": 900}}), energy=True)
 
