@@ -237,13 +237,16 @@ def test_tangential_impulse_is_traction_limited_and_never_reverses(model, iparam
     assert out[ct.OUT_AREA_XY] == pytest.approx(area_xy, rel=1e-12)
 
 
+@pytest.mark.parametrize("held", [False, True], ids=["first-step", "held"])
 @pytest.mark.parametrize("model,iparams", MODELS)
-def test_energy_account_of_contact(model, iparams):
+def test_energy_account_of_contact(model, iparams, held):
     """The contact's losses are powers at the end-of-step relative velocity: friction times the slip left
     (interface dissipation) and each push times the approach left (impact loss, jn gap / dt where a particle
     face is a gap away). The node's kinetic-energy change is the sphere's work minus those minus |J|^2 / 2m
     per node (in a lasting contact the velocity this step's internal force gave and the push took back, no
-    loss: docs/journal/2026-12-02-cfl.md); the identity checks all three terms at once."""
+    loss: docs/journal/2026-12-02-cfl.md); the identity checks all three terms at once. ``held``: every node was
+    pushed on the step before, so a node that now moves away from the sphere is in contact without a push
+    (friction only)."""
     case = make_case(40 + model)
     rng = np.random.default_rng(7)
     touching = case["cbuf"][:, 8] > 0
@@ -252,7 +255,13 @@ def test_energy_account_of_contact(model, iparams):
     gap = np.maximum(DX - case["cbuf"][:, 8], 0.0)
     inside, _, n, vn, _ = classify(case)
     pushed = inside & (case["grid_m"] > 0) & touching & (vn < -gap / DT)
-    grid_v, _, out = call(case, model, iparams)
+    grid_v = case["grid_v"].copy()
+    memory = (np.zeros(N_NODES, dtype=np.int64), 1, HOLD) if held else no_memory()
+    out = run_contact(case["grid_m"], grid_v, case["cbuf"].copy(), NO_FLAGS, memory, case["centre"], case["radius"],
+                      case["v_sphere"], model, iparams)
+    if held:  # friction on nodes that are held, not pushed
+        moved = np.linalg.norm(grid_v - case["grid_v"], axis=1) > 0
+        assert (moved & inside & ~pushed).sum() >= 5
     m, v0, vs = case["grid_m"], case["grid_v"], case["v_sphere"]
     J = m[:, None] * (grid_v - v0)
     jn = (J * n).sum(1)
