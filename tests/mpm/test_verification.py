@@ -176,6 +176,10 @@ def test_mirror_symmetry_half_and_full_domain_agree(half_and_full):
     assert abs(float(full.Fy[full.in_steady_window].mean())) < 0.01 * float(full.Fz_mean)
 
 
+ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
+                "frozen_kinetic_loss")
+
+
 def test_energy_balance(half_and_full):
     """External work = plastic + elastic + kinetic + interface slip + contact impact loss.
 
@@ -188,14 +192,9 @@ def test_energy_balance(half_and_full):
     """
     for ds in half_and_full:
         work = float(ds.external_work[-1])
-        parts = sum(float(ds[k][-1]) for k in ("plastic_work", "elastic_energy", "kinetic_energy",
-                                               "interface_dissipation", "contact_impact_loss", "frozen_kinetic_loss"))
+        parts = sum(float(ds[k][-1]) for k in ENERGY_TERMS)
         assert work > 0
         assert parts == pytest.approx(work, rel=0.10)
-
-
-ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
-                "frozen_kinetic_loss")
 
 
 def test_energy_account_does_not_follow_the_time_step():

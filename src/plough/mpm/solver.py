@@ -532,7 +532,7 @@ def check_stability(s: State, c: Constants) -> None:
         if bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 2] > c.grid_hi[2]:
             cause = (f"a particle rose above the grid's top (z = {c.grid_hi[2] * 1e6:.1f} um over the original "
                      "surface): material the sphere pushes up (a growing prow: set domain.headroom_m higher) or a "
-                     f"particle flung off the surface (lower mass_scaling or speed)")
+                     "particle flung off the surface (lower mass_scaling or speed)")
         elif bad == transfers.BAD_LEFT_GRID and index >= 0 and s.particles.x[index, 0] > c.grid_hi[0]:
             ahead = (s.particles.x[index, 0] - s.sphere.centre[0]) * 1e6
             cause = (f"a particle moved past the grid's far end (x = {c.grid_hi[0] * 1e6:.1f} um; the block ends at "
