@@ -5,7 +5,9 @@ error against its reference, the wall time, the closest a particle centre came t
 negative: inside) and, for the ploughing scenes, the energy balance:
 
 - ``hertz``: the sphere held 2 and 8 um deep in an elastic block (the verification tests' set-up,
-  :mod:`plough.mpm.indentation`), the force against Hertz's closed form;
+  :mod:`plough.mpm.indentation`), the force against Hertz's closed form; with two or more ``--domains-um`` also
+  the half-space's force extrapolated in 1 / L (``indentation.half_space_force``: the block is clamped on its
+  curved face, which stiffens it), a row per block and one for the half-space (``domain_um`` null);
 - ``tabor``: held 8 um deep in the uncoated rigid-plastic material (sigma_y = 300 MPa, E = 210 GPa, fully plastic:
   E a / (sigma_y R) ~ 200), the mean pressure Fz / (pi a_c^2) over the true contact (a_c where the particles'
   faces leave the sphere, pile-up included) against Tabor's 2.8-3.0 sigma_y; also with the contact's own area;
@@ -15,6 +17,7 @@ negative: inside) and, for the ploughing scenes, the energy balance:
 Run the pieces separately (each merges its rows into the one results file, keyed by case and contact):
 
     python benchmarks/contact_candidates.py hertz --sizes-um 10 5 --depths-um 2 8
+    python benchmarks/contact_candidates.py hertz --sizes-um 10 --depths-um 2 8 --domains-um 240 480 720 --contact grid
     python benchmarks/contact_candidates.py tabor --sizes-um 10 --depths-um 8
     python benchmarks/contact_candidates.py plough --scene uncoated coated --f 0 --sizes-um 10
     python benchmarks/contact_candidates.py plough --scene uncoated coated --f 0.5 1 --sizes-um 20 10
@@ -40,6 +43,7 @@ from plough.materials import ProportionalShear
 from plough.mpm.indentation import (
     TABOR_HARDNESS_PA,
     contact_radius_from_particles,
+    half_space_extrapolation,
     hertz_force,
     hertz_scene,
     hold_at_depth,
@@ -52,21 +56,37 @@ ENERGY_PARTS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_d
                 "frozen_kinetic_loss")
 
 
+def _hertz_row(h: float, d: float, mode: str, domain_um: float | None, force_N: float, run) -> dict:
+    ref = hertz_force(d * 1e-6)
+    block = "" if domain_um == 240.0 else (":L-inf" if domain_um is None else f":L{domain_um:g}")
+    row = {"case": f"hertz:h{h:g}:d{d:g}{block}", "contact": mode, "h_um": h, "depth_um": d, "domain_um": domain_um,
+           "force_N": force_N, "hertz_N": ref, "error": force_N / ref - 1.0}
+    if run is not None:
+        row.update({"force_std_rel": run.force_std_N / run.force_N, "force_drift": run.force_drift,
+                    "steps": run.steps, "wall_s": run.wall_s, "particles": run.state.particles.n,
+                    "closest_centre_h": run.closest_centre_m / (h * 1e-6),
+                    "plastic": bool(run.state.particles.eps_p.max() > 0.0)})
+    where = "half-space (1 / L)" if domain_um is None else f"L={domain_um:g}"
+    print(f"hertz h={h:g} d={d:g} {where} {mode:8s} F={force_N:.4g} N err={row['error']:+.3f}"
+          + ("" if run is None else f" drift={run.force_drift:+.4f} wall={run.wall_s:.1f}s "
+                                    f"closest={row['closest_centre_h']:.3f} h"), flush=True)
+    return row
+
+
 def hertz(args) -> list[dict]:
     rows = []
     for h in args.sizes_um:
         for d in args.depths_um:
             for mode in args.contact:
-                run = hold_at_depth(hertz_scene(h, d, contact_mode=mode))
-                ref = hertz_force(d * 1e-6)
-                row = {"case": f"hertz:h{h:g}:d{d:g}", "contact": mode, "h_um": h, "depth_um": d,
-                       "force_N": run.force_N, "hertz_N": ref, "error": run.force_N / ref - 1.0,
-                       "force_std_rel": run.force_std_N / run.force_N, "steps": run.steps, "wall_s": run.wall_s,
-                       "particles": run.state.particles.n, "closest_centre_h": run.closest_centre_m / (h * 1e-6),
-                       "plastic": bool(run.state.particles.eps_p.max() > 0.0)}
-                print(f"hertz h={h:g} d={d:g} {mode:8s} F={run.force_N:.4g} N err={row['error']:+.3f} "
-                      f"wall={run.wall_s:.1f}s closest={row['closest_centre_h']:.3f} h", flush=True)
-                rows.append(row)
+                runs = [hold_at_depth(hertz_scene(h, d, domain_um=L, contact_mode=mode)) for L in args.domains_um]
+                for L, run in zip(args.domains_um, runs, strict=True):
+                    rows.append(_hertz_row(h, d, mode, L, run.force_N, run))
+                if len(set(args.domains_um)) > 1:
+                    f_inf, stiffening = half_space_extrapolation([L * 1e-6 for L in args.domains_um],
+                                                                 [run.force_N for run in runs])
+                    row = _hertz_row(h, d, mode, None, f_inf, None)
+                    row["stiffening_um"] = stiffening * 1e6
+                    rows.append(row)
     return rows
 
 
@@ -146,6 +166,8 @@ def main() -> None:
     parser.add_argument("--contact", nargs="+", default=["grid", "particle"])
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[10.0])
     parser.add_argument("--depths-um", type=float, nargs="+", default=[2.0, 8.0])
+    parser.add_argument("--domains-um", type=float, nargs="+", default=[240.0],
+                        help="hertz: block radii; two or more add the half-space extrapolated in 1 / L")
     parser.add_argument("--scene", nargs="+", default=["uncoated", "coated"], choices=sorted(common.EXAMPLES))
     parser.add_argument("--f", type=float, nargs="+", default=[0.0])
     parser.add_argument("--k1", type=float, default=125.0, help="analytical model's k1 (coated scenes)")
