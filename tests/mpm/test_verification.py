@@ -46,8 +46,8 @@ def indentation_force(h_um: float, depth_um: float, domain_um: float = 240.0, po
 def test_hertz_indentation_error_shrinks_with_h():
     """F = 4/3 E* sqrt(R) d^1.5 for a rigid sphere on an elastic half-space (depth d = 2 um), the grid contact.
 
-    Measured in the checks' block (radius 240 um, clamped; the hold settled, docs/journal/2026-12-03-hertz-block.md):
-    +85.7% at h = 10 um, +29.1% at h = 5 um (with the earlier 300-step hold +89% / +34%, a transient). The block
+    Measured in the checks' block (radius 240 um, clamped; the hold settled, docs/journal/2026-12-02-hertz-block.md):
+    +85.8% at h = 10 um, +29.3% at h = 5 um (with the earlier 300-step hold +89% / +34%, a transient). The block
     itself adds about 13% at this depth (half-space +64% / about +15%): the contact acts on grid nodes up to one
     cell outside the sphere, an error of order h that halving h more than halves.
     """
@@ -62,7 +62,7 @@ def test_grid_contact_meets_the_hertz_target_at_h10_in_a_half_space():
     """Issue 32's Hertz target at h = 10 um (within 25%), 8 um deep, for the default grid contact, against the
     half-space Hertz's formula is for: the block is clamped on its curved face, which stiffens it in proportion
     to a / L, so the force is measured in blocks of radius 240 and 480 um and extrapolated in 1 / L
-    (indentation.half_space_force). Measured (docs/journal/2026-12-03-hertz-block.md): +36.5% / +24.6% in the two
+    (indentation.half_space_force). Measured (docs/journal/2026-12-02-hertz-block.md): +36.5% / +24.6% in the two
     blocks (+20.6% at 720 um; 1 / L fits the three within 0.01%), the half-space +12.7%, the block's stiffening
     A = 50.7 um (50.2 um at h = 5 um, where the half-space error is +8.0%)."""
     depth = 8e-6
@@ -79,7 +79,7 @@ def test_grid_contact_meets_the_hertz_target_at_h10_in_a_half_space():
 def test_particle_contact_meets_the_hertz_target_at_h10():
     """The particle contact (discretisation.contact: particle) acts where the sphere is. In the checks' 240 um block,
     settled, at the solver's 4 Gauss-Seidel sweeps the force falls as its particles creep into the sphere (8 um:
-    +25% to +12% over 96 wave crossings, the closest centre 0.48 h -> 0.26 h; docs/journal/2026-12-03-hertz-block.md);
+    +25% to +12% over 96 wave crossings, the closest centre 0.48 h -> 0.26 h; docs/journal/2026-12-02-hertz-block.md);
     at 20 sweeps it holds (+15.7% / +24.6% at 2 / 8 um in this block; +4.1% / +2.9% in the half-space, 1 / L from
     240 and 480 um blocks). Asserted in this block, at 4 sweeps: the error within 20% / 25%, positive (the block
     adds 13-21%), and no particle centre inside the sphere."""
@@ -96,7 +96,7 @@ def test_projected_dilatation_removes_volumetric_locking_in_hertz_contact():
     In a clamped block the force grows with nu beyond Hertz's E* = E / (1 - nu^2) too (an incompressible layer on a
     rigid base is stiffer), so only the two dilatations' changes are compared, in one block. Measured at h = 10 um,
     depth 2 um, settled (the hold of a nearly incompressible block lasts 22 times longer: its shear waves are that
-    much slower; docs/journal/2026-12-03-hertz-block.md), the change of the error from nu = 0.3 to 0.499: block of
+    much slower; docs/journal/2026-12-02-hertz-block.md), the change of the error from nu = 0.3 to 0.499: block of
     radius 120 um (this test) local +1.20, projected +0.26; 240 um local +0.69, projected +0.16 (the earlier
     300-step hold gave +0.51 / +0.02: a transient). The projected dilatation takes away three quarters of it.
     """

@@ -10,7 +10,7 @@ and the contact benchmark (docs/verification.md: Hertz, Tabor).
   about one period of the block's slowest mode (:data:`AVERAGE_CROSSINGS` crossings);
 - :func:`half_space_force`: Hertz's half-space from blocks of two or more sizes. The block is clamped on its
   curved face, which stiffens it: F(L) = F_inf (1 + A / L) to first order in a / L, as for an elastic layer on a
-  rigid base. Measured (docs/journal/2026-12-03-hertz-block.md): at h = 10 um and 8 um depth, the grid contact's
+  rigid base. Measured (docs/journal/2026-12-02-hertz-block.md): at h = 10 um and 8 um depth, the grid contact's
   force is +36.5% / +24.6% / +20.6% above Hertz in blocks of radius 240 / 480 / 720 um, and 1 / L fits the three
   within 0.01%: the half-space error is +12.7%, the 240 um block adds 21%;
 - :func:`contact_radius_from_particles`: the radius where the material's surface (the particles' faces, pile-up

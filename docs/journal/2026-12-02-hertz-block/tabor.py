@@ -1,6 +1,6 @@
 """Tabor's mean pressure with the settled hold (indentation.hold_at_depth) in blocks of two sizes.
 
-Run from the repository root: python docs/journal/2026-12-03-hertz-block/tabor.py CONTACT:H_UM:DEPTH_UM:DOMAIN_UM ...
+Run from the repository root: python docs/journal/2026-12-02-hertz-block/tabor.py CONTACT:H_UM:DEPTH_UM:DOMAIN_UM ...
 """
 
 import json

@@ -1,6 +1,6 @@
 """Hertz force against the block's size: is the finite, clamped block the Hertz 'error' that does not shrink with h?
 
-Run from the repository root: python docs/journal/2026-12-03-hertz-block/probe.py --cases grid:10:2:240 ...
+Run from the repository root: python docs/journal/2026-12-02-hertz-block/probe.py --cases grid:10:2:240 ...
 Each case is contact:h_um:depth_um:domain_um[:sweeps] (sweeps only for the particle contact; default the
 solver's 4). One JSON line per case to --out (appended) and to stdout.
 """
