@@ -49,11 +49,10 @@ from plough.mpm.indentation import (
     hold_at_depth,
     tabor_scene,
 )
+from plough.mpm.io import energy_balance
 from plough.mpm.run import warm_up
 
 OUT = common.ROOT / "benchmarks" / "results" / "contact_candidates.json"
-ENERGY_PARTS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
-                "frozen_kinetic_loss")
 
 
 def _hertz_row(h: float, d: float, mode: str, domain_um: float | None, force_N: float, run) -> dict:
@@ -134,9 +133,7 @@ def plough(args) -> list[dict]:
                     t0 = time.perf_counter()
                     ds = simulate(scene, progress=False, threads=args.threads)
                     wall = time.perf_counter() - t0
-                    work = float(ds.external_work[-1])
                     n_rec = len(ds.contact_area_xy)  # the contact's own area, mean over the second half
-                    parts = sum(float(ds[k][-1]) for k in ENERGY_PARTS)
                     row = {"case": f"plough:{name}:f{f:g}:h{h:g}", "contact": mode, "scene": name, "f": f,
                            "h_um": h, **{q: float(ds[q]) for q in common.RESULTS},
                            "analytical_mu": float(ana.mu), "analytical_mu_pl": float(ana.mu_pl),
@@ -144,7 +141,7 @@ def plough(args) -> list[dict]:
                            "analytical_Axy_um2": float(ana.Axy) * 1e12,
                            "contact_area_xy_um2": float(ds.contact_area_xy[n_rec // 2:].mean()) * 1e12,
                            "mu_error": float(ds.mu) / float(ana.mu) - 1.0,
-                           "energy_parts_over_work": parts / work if work > 0 else float("nan"),
+                           "energy_parts_over_work": energy_balance(ds),
                            "closest_centre_h": -float(ds.max_particle_penetration) / (h * 1e-6),
                            "steady": float(ds.steady), "wall_s": wall, "steps": int(ds.attrs["cost_steps"]),
                            "particles": int(ds.attrs["cost_particles"])}

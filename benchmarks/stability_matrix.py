@@ -20,14 +20,13 @@ from pathlib import Path
 import numba
 import yaml
 
+from plough.mpm.io import energy_balance
 from plough.mpm.run import simulate
 from plough.mpm.scene import Scene
 from plough.mpm.solver import SimulationError
 
 ROOT = Path(__file__).resolve().parents[1]
 BASE = yaml.safe_load((ROOT / "examples" / "stability_small.yaml").read_text())
-ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
-                "frozen_kinetic_loss")
 
 
 def variant(**changes) -> dict:
@@ -79,7 +78,7 @@ def main() -> None:
             print(f"| {name} | stopped: {exc} | | | | |", flush=True)
             continue
         h = scene.discretisation.particle_size_m
-        ratio = sum(float(ds[k][-1]) for k in ENERGY_TERMS) / float(ds.external_work[-1])
+        ratio = energy_balance(ds)
         rows[name] = {"outcome": "completed", "mu": float(ds.mu), "Fz_over_load": float(ds.Fz_mean) / scene.load_N,
                       "max_penetration_over_h": float(ds.max_particle_penetration) / h, "energy_ratio": ratio}
         r = rows[name]

@@ -9,6 +9,7 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+import xarray as xr
 
 from plough.mpm import io
 from plough.mpm.io import residual_profiles
@@ -299,3 +300,13 @@ def test_contact_summary_of_the_shear_split():
     assert out["mu_sh_rear"] == (2.0 + 2.0) / 4.0 and out["mu_sh_carried"] == 2.0 / 4.0
     series = {k: np.zeros(3) for k in CONTACT_SPLIT_META}  # no front contact in the window: nothing, never NaN
     assert contact_summary(series, mask, fz=4.0) == {}
+
+
+def test_energy_balance_sums_the_energy_terms_over_the_work_at_the_end():
+    steps = 3
+    terms = {k: ("step", np.linspace(0.0, 0.1 * (i + 1), steps)) for i, k in enumerate(io.ENERGY_TERMS)}
+    work = 0.1 * sum(range(1, len(io.ENERGY_TERMS) + 1)) / 0.97  # the terms hold 0.97 of it at the end
+    ds = xr.Dataset({**terms, "external_work": ("step", np.linspace(0.0, work, steps))})
+    assert io.energy_balance(ds) == pytest.approx(0.97, rel=1e-12)
+    assert set(io.ENERGY_TERMS) <= set(io.SERIES_META)  # each term is a recorded series with units
+    assert math.isnan(io.energy_balance(ds.assign(external_work=("step", np.zeros(steps)))))

@@ -60,6 +60,21 @@ SERIES_META = {
     "heat": ("J", "adiabatic heat, Taylor-Quinney factor x plastic work (cumulative)"),
     "time": ("s", "simulated time"),
 }
+#: the terms the sphere's work (``external_work``) goes into, each cumulative in J: their sum over that work is the
+#: run's energy balance (:func:`energy_balance`; docs/verification.md, the energy rows)
+ENERGY_TERMS = ("plastic_work", "elastic_energy", "kinetic_energy", "interface_dissipation", "contact_impact_loss",
+                "frozen_kinetic_loss")
+
+
+def energy_balance(ds: xr.Dataset) -> float:
+    """The sum of :data:`ENERGY_TERMS` over ``external_work`` at a run's end (1: every joule accounted for).
+
+    Reads those variables' last values from a run's dataset; NaN if the sphere did no work.
+    """
+    work = float(ds["external_work"][-1])
+    return sum(float(ds[k][-1]) for k in ENERGY_TERMS) / work if work > 0.0 else float("nan")
+
+
 #: the grid contact's split of its interface shear (contact.OUT_SH_AREA on; interval means like the forces, full
 #: body; 0 with the particle contact): a region is in front of the sphere's centre in x or behind it (rear), and
 #: below the original surface or above it (_up: pile-up, prow)
