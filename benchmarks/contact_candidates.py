@@ -26,9 +26,11 @@ Run the pieces separately (each merges its rows into the one results file, keyed
 from __future__ import annotations
 
 import argparse
+import inspect
 import json
 import math
 import time
+from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
 
@@ -42,6 +44,7 @@ from plough.io import git_commit
 from plough.materials import ProportionalShear
 from plough.mpm.indentation import (
     TABOR_HARDNESS_PA,
+    Indentation,
     contact_radius_from_particles,
     half_space_extrapolation,
     hertz_force,
@@ -53,20 +56,27 @@ from plough.mpm.io import energy_balance
 from plough.mpm.run import warm_up
 
 OUT = common.ROOT / "benchmarks" / "results" / "contact_candidates.json"
+CHECK_BLOCK_UM = inspect.signature(hertz_scene).parameters["domain_um"].default  # the verification checks' block
 
 
-def _hertz_row(h: float, d: float, mode: str, domain_um: float | None, force_N: float, run) -> dict:
-    ref = hertz_force(d * 1e-6)
-    block = "" if domain_um == 240.0 else (":L-inf" if domain_um is None else f":L{domain_um:g}")
-    row = {"case": f"hertz:h{h:g}:d{d:g}{block}", "contact": mode, "h_um": h, "depth_um": d, "domain_um": domain_um,
-           "force_N": force_N, "hertz_N": ref, "error": force_N / ref - 1.0}
+def _hertz_row(h_um: float, depth_um: float, mode: str, domains_um: Sequence[float], force_N: float,
+               run: Indentation | None) -> dict:
+    """A result row: one block (``domains_um`` of one radius, ``run`` its hold) or the half-space fitted through
+    several (``run`` None); the checks' 240 um block keeps the case key it had before the blocks were varied."""
+    ref = hertz_force(depth_um * 1e-6)
+    if run is None:
+        block = ":L-inf-" + "-".join(f"{L:g}" for L in domains_um)
+    else:
+        block = "" if domains_um[0] == CHECK_BLOCK_UM else f":L{domains_um[0]:g}"
+    row = {"case": f"hertz:h{h_um:g}:d{depth_um:g}{block}", "contact": mode, "h_um": h_um, "depth_um": depth_um,
+           "domains_um": list(domains_um), "force_N": force_N, "hertz_N": ref, "error": force_N / ref - 1.0}
     if run is not None:
         row.update({"force_std_rel": run.force_std_N / run.force_N, "force_drift": run.force_drift,
                     "steps": run.steps, "wall_s": run.wall_s, "particles": run.state.particles.n,
-                    "closest_centre_h": run.closest_centre_m / (h * 1e-6),
+                    "closest_centre_h": run.closest_centre_m / (h_um * 1e-6),
                     "plastic": bool(run.state.particles.eps_p.max() > 0.0)})
-    where = "half-space (1 / L)" if domain_um is None else f"L={domain_um:g}"
-    print(f"hertz h={h:g} d={d:g} {where} {mode:8s} F={force_N:.4g} N err={row['error']:+.3f}"
+    where = "half-space (1 / L)" if run is None else f"L={domains_um[0]:g}"
+    print(f"hertz h={h_um:g} d={depth_um:g} {where} {mode:8s} F={force_N:.4g} N err={row['error']:+.3f}"
           + ("" if run is None else f" drift={run.force_drift:+.4f} wall={run.wall_s:.1f}s "
                                     f"closest={row['closest_centre_h']:.3f} h"), flush=True)
     return row
@@ -79,11 +89,11 @@ def hertz(args) -> list[dict]:
             for mode in args.contact:
                 runs = [hold_at_depth(hertz_scene(h, d, domain_um=L, contact_mode=mode)) for L in args.domains_um]
                 for L, run in zip(args.domains_um, runs, strict=True):
-                    rows.append(_hertz_row(h, d, mode, L, run.force_N, run))
+                    rows.append(_hertz_row(h, d, mode, [L], run.force_N, run))
                 if len(set(args.domains_um)) > 1:
                     f_inf, stiffening = half_space_extrapolation([L * 1e-6 for L in args.domains_um],
                                                                  [run.force_N for run in runs])
-                    row = _hertz_row(h, d, mode, None, f_inf, None)
+                    row = _hertz_row(h, d, mode, args.domains_um, f_inf, None)
                     row["stiffening_um"] = stiffening * 1e6
                     rows.append(row)
     return rows
@@ -163,7 +173,7 @@ def main() -> None:
     parser.add_argument("--contact", nargs="+", default=["grid", "particle"])
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[10.0])
     parser.add_argument("--depths-um", type=float, nargs="+", default=[2.0, 8.0])
-    parser.add_argument("--domains-um", type=float, nargs="+", default=[240.0],
+    parser.add_argument("--domains-um", type=float, nargs="+", default=[CHECK_BLOCK_UM],
                         help="hertz: block radii; two or more add the half-space extrapolated in 1 / L")
     parser.add_argument("--scene", nargs="+", default=["uncoated", "coated"], choices=sorted(common.EXAMPLES))
     parser.add_argument("--f", type=float, nargs="+", default=[0.0])

@@ -7,6 +7,7 @@ import math
 
 import pytest
 
+from plough.mpm import solver
 from plough.mpm.indentation import crossing_steps, half_space_extrapolation, hertz_scene
 
 
@@ -19,15 +20,21 @@ def test_half_space_extrapolation_recovers_a_first_order_block_stiffening(domain
     assert got_a == pytest.approx(a, rel=1e-10)
 
 
-def test_half_space_extrapolation_needs_two_block_sizes():
+def test_half_space_extrapolation_needs_two_block_sizes_and_a_force_for_each():
     with pytest.raises(ValueError, match="domains_m"):
         half_space_extrapolation([240e-6, 240e-6], [1.0, 1.1])
+    with pytest.raises(ValueError, match="forces_N"):
+        half_space_extrapolation([240e-6, 480e-6], [1.0])
 
 
 def test_crossing_steps_is_the_block_radius_over_a_shear_waves_travel_a_step():
-    # dt = cfl dx / c_p: a P wave travels cfl dx a step, 240 um at cfl 0.3 and dx = 2 h = 20 um in 40 steps; a shear
-    # wave is slower by sqrt(G / (K + 4 G / 3)) = sqrt((1 - 2 nu) / (2 (1 - nu)))
+    # the solver's dt = cfl dx / (c_p + v_max): a P wave travels just under cfl dx a step, 240 um at cfl 0.3 and
+    # dx = 2 h = 20 um in about 40 steps; a shear wave is slower by sqrt(G / (K + 4 G / 3)) = sqrt((1 - 2 nu) /
+    # (2 (1 - nu))): about 75 steps at nu = 0.3, 895 at nu = 0.499
     for nu in (0.3, 0.499):
-        ratio = math.sqrt(2.0 * (1.0 - nu) / (1.0 - 2.0 * nu))
-        assert crossing_steps(hertz_scene(10.0, 2.0, domain_um=240.0, poisson_ratio=nu)) == round(40 * ratio)
-        assert crossing_steps(hertz_scene(5.0, 2.0, domain_um=480.0, poisson_ratio=nu)) == round(160 * ratio)
+        scene = hertz_scene(10.0, 2.0, domain_um=240.0, poisson_ratio=nu)
+        _, const = solver.init(scene)
+        steps = crossing_steps(scene, const.dt)
+        expected = 240e-6 / (0.3 * 20e-6) * math.sqrt(2.0 * (1.0 - nu) / (1.0 - 2.0 * nu))
+        assert expected <= steps <= 1.05 * expected, (nu, steps, expected)
+        assert crossing_steps(scene, 0.5 * const.dt) in (2 * steps - 1, 2 * steps)

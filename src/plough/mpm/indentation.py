@@ -8,11 +8,13 @@ and the contact benchmark (docs/verification.md: Hertz, Tabor).
 - :func:`hold_at_depth`: press to the depth, settle until the block's elastic ringing has died down
   (:data:`SETTLE_CROSSINGS` times the steps a shear wave takes to cross the block), and average the full-body force over
   about one period of the block's slowest mode (:data:`AVERAGE_CROSSINGS` crossings);
-- :func:`half_space_force`: Hertz's half-space from blocks of two or more sizes. The block is clamped on its
+- :func:`crossing_steps`: the steps a shear wave takes to cross the block, the hold's unit of time;
+- :func:`half_space_force` (:class:`HalfSpace`; the fit :func:`half_space_extrapolation`): Hertz's half-space
+  from blocks of two or more sizes. The block is clamped on its
   curved face, which stiffens it: F(L) = F_inf (1 + A / L) to first order in a / L, as for an elastic layer on a
   rigid base. Measured (docs/journal/2026-12-02-hertz-block.md): at h = 10 um and 8 um depth, the grid contact's
-  force is +36.5% / +24.6% / +20.6% above Hertz in blocks of radius 240 / 480 / 720 um, and 1 / L fits the three
-  within 0.01%: the half-space error is +12.7%, the 240 um block adds 21%;
+  force is +38.7% / +24.6% / +20.6% above Hertz in blocks of radius 240 / 480 / 720 um, and 1 / L fits the three
+  within 0.4%: the half-space error is +11.3%, the 240 um block adds about a fifth;
 - :func:`contact_radius_from_particles`: the radius where the material's surface (the particles' faces, pile-up
   included) leaves the sphere, from rings of one particle size around the sphere's axis.
 """
@@ -87,23 +89,23 @@ class Indentation:
 
 
 #: settle for this many times the steps a shear wave takes to cross the block's radius (the grid contact's force in
-#: the 240 um block at h = 10 um, nu = 0.3, settles to 0.5% within about eleven)
+#: the 240 um block at h = 10 um, nu = 0.3, is then within about 1.5% of where it ends after 96 P-wave crossings)
 SETTLE_CROSSINGS = 12.0
 #: average the force over this many crossings, at least a period of the block's slowest mode
 AVERAGE_CROSSINGS = 4.0
 
 
-def crossing_steps(scene: Scene) -> int:
-    """Steps a shear wave takes to cross the block's radius.
+def crossing_steps(scene: Scene, dt_s: float) -> int:
+    """Steps of ``dt_s`` a shear wave takes to cross the block's radius, in the scene's slowest material.
 
-    A P wave crosses a cell in dt = cfl dx / c_p (less the sliding speed's share), so the radius in radius / (cfl dx)
-    steps; the shear wave is slower by c_s / c_p = sqrt(G / (K + 4 G / 3)) (1 / 1.87 at nu = 0.3, 1 / 22 at
-    nu = 0.499): the slowest modes of a nearly incompressible block are its shear modes.
+    The shear speed is sqrt(G / (mass_scaling rho)); dt = cfl dx / (c_p + v_max) is set by the fastest P wave, so
+    a P wave crosses the radius in about radius / (cfl dx) steps and a shear wave in sqrt((K + 4 G / 3) / G) times
+    as many (1.87 at nu = 0.3, 22 at nu = 0.499): the slowest modes of a nearly incompressible block are its shear
+    modes.
     """
-    disc, mat = scene.discretisation, scene.layers.substrate
-    g = mat.shear_modulus_Pa
-    p_over_s = math.sqrt((mat.bulk_modulus_Pa + 4.0 * g / 3.0) / g)
-    return max(1, int(round(scene.domain.radius_m / (disc.cfl * disc.cell_size_m) * p_over_s)))
+    ms = scene.discretisation.mass_scaling
+    c_s = min(math.sqrt(m.shear_modulus_Pa / (ms * m.density_kg_m3)) for m in scene.layers.materials)
+    return max(1, math.ceil(scene.domain.radius_m / (c_s * dt_s)))
 
 
 def hold_at_depth(scene: Scene, settle_crossings: float = SETTLE_CROSSINGS) -> Indentation:
@@ -113,10 +115,11 @@ def hold_at_depth(scene: Scene, settle_crossings: float = SETTLE_CROSSINGS) -> I
     the slowest with a period of a few shear-wave crossings of the block's radius (:func:`crossing_steps`). So the
     sphere is held for ``settle_crossings`` crossings (at least ``solver.SETTLE_STEPS`` steps) and the force averaged
     over the last :data:`AVERAGE_CROSSINGS` of them; ``force_drift`` compares that mean with the window before it.
+    The hold lasts at least two averaging windows (eight crossings), whatever ``settle_crossings`` says.
     """
     state, const = solver.init(scene)
     state.sphere.centre[0] = 0.5 * scene.domain.length_m
-    crossing = crossing_steps(scene)
+    crossing = crossing_steps(scene, const.dt)
     window = max(1, int(AVERAGE_CROSSINGS * crossing))
     state.sphere.settle_left = max(solver.SETTLE_STEPS, int(settle_crossings * crossing), 2 * window)
     fz, area = [], []
@@ -150,6 +153,8 @@ def half_space_extrapolation(domains_m: Sequence[float], forces_N: Sequence[floa
     """(F_inf, A) of F(L) = F_inf (1 + A / L) through the forces measured in blocks of radius L (least squares in
     1 / L; exact for two blocks)."""
     inv = 1.0 / np.asarray(domains_m, dtype=float)
+    if len(forces_N) != inv.size:
+        raise ValueError(f"forces_N: {len(forces_N)} forces for {inv.size} block radii; give one per block")
     if inv.size < 2 or np.unique(inv).size < 2:
         raise ValueError(f"domains_m: {list(domains_m)} must hold at least two different block radii")
     slope, intercept = np.polyfit(inv, np.asarray(forces_N, dtype=float), 1)
