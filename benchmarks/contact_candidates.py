@@ -7,7 +7,8 @@ negative: inside) and, for the ploughing scenes, the energy balance:
 - ``hertz``: the sphere held 2 and 8 um deep in an elastic block (the verification tests' set-up,
   :mod:`plough.mpm.indentation`), the force against Hertz's closed form; with two or more ``--domains-um`` also
   the half-space's force extrapolated in 1 / L (``indentation.half_space_force``: the block is clamped on its
-  curved face, which stiffens it), a row per block and one for the half-space (``domain_um`` null);
+  curved face, which stiffens it), a row per block (case ``hertz:hH:dD:LL``; the checks' 240 um block keeps
+  ``hertz:hH:dD``) and one for the half-space (``hertz:hH:dD:L-inf-L1-L2...``, ``stiffening_um`` = A);
 - ``tabor``: held 8 um deep in the uncoated rigid-plastic material (sigma_y = 300 MPa, E = 210 GPa, fully plastic:
   E a / (sigma_y R) ~ 200), the mean pressure Fz / (pi a_c^2) over the true contact (a_c where the particles'
   faces leave the sphere, pile-up included) against Tabor's 2.8-3.0 sigma_y; also with the contact's own area;
