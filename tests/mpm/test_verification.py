@@ -113,25 +113,24 @@ def test_projected_dilatation_removes_volumetric_locking_in_hertz_contact():
 
 
 def test_tabor_indentation_at_h10():
-    """Fully plastic static indentation (issue 32, item 4): the sphere held 8 um deep in the uncoated rigid-plastic
-    block (sigma_y = 300 MPa, E a / (sigma_y R) ~ 200), h = 10 um, the grid contact. Measured
-    (benchmarks/contact_candidates.py tabor; docs/verification.md, the Tabor row): F = 8.27 N (8.26 N with the
-    settled hold; 8.62 N in a 480 um block: docs/journal/2026-12-02-hertz-block.md), the true contact
-    (pile-up included, where the particles' faces leave the sphere) a_c = 67.2 um against the sphere's section at
-    the original surface 56.0 um; mean pressure 1.94 sigma_y over the true contact, 2.80 sigma_y over the section.
-    The force is Tabor's (2.8-3.0 sigma_y) over the sphere's own section; over the true contact, the issue's
-    measure, the target 2.6-3.3 is not met (the measured contact is 1.2x the section in radius; how much of that
-    is pile-up and how much the contact acting outside the sphere is not separated). Asserted: Tabor over the
-    section, a contact wider than the section, and the true-contact pressure within 10% of the 1.94 reached."""
+    """Fully plastic static indentation (issue 32, item 4): the sphere pressed quasi-statically
+    (indentation.QUASI_STATIC_PRESS_FRACTION) and held 8 um deep in the uncoated rigid-plastic block
+    (sigma_y = 300 MPa, E a / (sigma_y R) ~ 200), h = 10 um, the grid contact. Measured
+    (docs/journal/2026-12-03-tabor.md; docs/verification.md, the Tabor row): F = 12.69 N, the true contact (pile-up
+    included, where the particles' faces leave the sphere) a_c = 64.0 um against the sphere's section at the
+    original surface 56.0 um, mean pressure 3.29 sigma_y over the true contact (Tabor 2.8-3.0; the issue's target
+    2.6-3.3). Pressed at the scenes' default speed the held force was 8.2 N (1.92 sigma_y): the plastic zone
+    overshoots when the press stops. Asserted: the target, and a pile-up of the size elastic-perfectly plastic
+    spheres show (a_c / a_section between 1 and 1.25; measured 1.14)."""
     depth = 8e-6
     run = hold_at_depth(tabor_scene(10.0, depth * 1e6))
     sigma_y = TABOR_HARDNESS_PA / 3.0
     a_c = contact_radius_from_particles(run.state, run.const)
     a_section = math.sqrt(2.0 * R_M * depth - depth**2)
     assert run.state.particles.eps_p.max() > 0.01  # fully plastic under the sphere
-    assert 2.6 < run.force_N / (math.pi * a_section**2) / sigma_y < 3.3
-    assert a_c > a_section
-    assert 1.75 < run.force_N / (math.pi * a_c**2) / sigma_y < 2.15
+    assert abs(run.force_drift) < 0.02  # settled
+    assert 2.6 < run.force_N / (math.pi * a_c**2) / sigma_y < 3.3
+    assert 1.0 < a_c / a_section < 1.25
 
 
 def _workflow_example(name: str, h_um: float, f: float, contact_mode: str) -> Scene:
