@@ -3,8 +3,8 @@ changed at a time; the full force history is kept so the relaxation under the he
 
 Run from the repository root:
     python docs/journal/2026-12-03-tabor/probe.py --case NAME:H_UM[:KEY=VALUE ...] ... --out FILE.jsonl
-KEYs: ms (mass scaling), flip, cfl, press (press speed fraction of 0.1 m/s; default 0.25, the scenes'), settle (shear-wave crossings held), L (block
-radius, um), depth (um), contact, dil (dilatation), ppc (particles per cell).
+KEYs: ms (mass scaling), flip, cfl, press (press speed fraction of 0.1 m/s; default 0.25, the scenes'), settle
+(shear-wave crossings held), L (block radius, um), depth (um), contact, dil (dilatation), ppc (particles per cell).
 """
 
 from __future__ import annotations
@@ -18,16 +18,22 @@ from dataclasses import replace
 import numpy as np
 
 from plough.mpm import contact, solver
-from plough.mpm.indentation import (AVERAGE_CROSSINGS, R_M, TABOR_HARDNESS_PA, contact_radius_from_particles,
-                                    crossing_steps, tabor_scene)
+from plough.mpm.indentation import (
+    AVERAGE_CROSSINGS,
+    R_M,
+    TABOR_HARDNESS_PA,
+    contact_radius_from_particles,
+    crossing_steps,
+    tabor_scene,
+)
 
 
 def run(spec: str) -> dict:
     name, h, *kv = spec.split(":")
     opts = dict(item.split("=") for item in kv)
     depth = float(opts.get("depth", 8.0))
-    scene = tabor_scene(float(h), depth, domain_um=float(opts.get("L", 240.0)), contact_mode=opts.get("contact", "grid"),
-                        particles_per_cell=int(opts.get("ppc", 2)))
+    scene = tabor_scene(float(h), depth, domain_um=float(opts.get("L", 240.0)),
+                        contact_mode=opts.get("contact", "grid"), particles_per_cell=int(opts.get("ppc", 2)))
     d = scene.discretisation
     d = replace(d, mass_scaling=float(opts.get("ms", d.mass_scaling)), flip=float(opts.get("flip", d.flip)),
                 cfl=float(opts.get("cfl", d.cfl)), dilatation=opts.get("dil", d.dilatation))
