@@ -46,9 +46,9 @@ def hertz_force(depth_m: float, radius_m: float = R_M, youngs_Pa: float = E_PA, 
 #: press speed of the plastic indentation as a fraction of the scenes' 0.1 m/s (the scenes' default is 0.25). A
 #: mass-scaled press that stops at the depth leaves the plastic zone under the sphere moving: it flows on, the crater
 #: deepens past the sphere and the contact unloads elastically, and plastic flow does not give the force back. The
-#: overshoot's depth, about v a / c_s, compares with the contact's elastic recovery p a / E* as
-#: v sqrt(mass_scaling rho E*) / p: about 1.2 at the default press (v sqrt(mass_scaling) = 25 m/s), which halves the
-#: held force (15.4 N at the press's end, 8.2 N held, h = 10 um, 8 um deep). The held force converges as the press
+#: overshoot's depth, about v a / c_s (c_s the mass-scaled shear speed), compares with the contact's elastic recovery
+#: p a / E* as v E* / (c_s p): about 2 at the default press (v sqrt(mass_scaling) = 25 m/s), where the held force was
+#: 8.2 N against 12.7 N pressed slowly (h = 10 um, 8 um deep). The held force converges as the press
 #: slows: 12.35 / 12.51 / 12.69 N at v sqrt(mass_scaling) = 5 / 2 / 1 m/s (mass scaling 1e6), 12.70 / 12.73 N at 1 /
 #: 0.5 m/s with mass scaling 1e4 (docs/journal/2026-12-03-tabor.md). An elastic block gives its force back, so the
 #: Hertz checks keep the default press.
