@@ -44,6 +44,7 @@ from plough.analytical import ploughing
 from plough.io import git_commit
 from plough.materials import ProportionalShear
 from plough.mpm.indentation import (
+    PLASTIC_SETTLE_CROSSINGS,
     TABOR_HARDNESS_PA,
     Indentation,
     contact_radius_from_particles,
@@ -106,7 +107,7 @@ def tabor(args) -> list[dict]:
     for h in args.sizes_um:
         for d in args.depths_um:
             for mode in args.contact:
-                run = hold_at_depth(tabor_scene(h, d, contact_mode=mode))
+                run = hold_at_depth(tabor_scene(h, d, contact_mode=mode), settle_crossings=PLASTIC_SETTLE_CROSSINGS)
                 a_c = contact_radius_from_particles(run.state, run.const)
                 a_geo = math.sqrt(2 * 200e-6 * d * 1e-6 - (d * 1e-6) ** 2)
                 row = {"case": f"tabor:h{h:g}:d{d:g}", "contact": mode, "h_um": h, "depth_um": d,
