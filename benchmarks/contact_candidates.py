@@ -52,6 +52,7 @@ from plough.mpm.indentation import (
     hertz_force,
     hertz_scene,
     hold_at_depth,
+    section_radius,
     tabor_scene,
 )
 from plough.mpm.io import energy_balance
@@ -109,7 +110,7 @@ def tabor(args) -> list[dict]:
             for mode in args.contact:
                 run = hold_at_depth(tabor_scene(h, d, contact_mode=mode), settle_crossings=PLASTIC_SETTLE_CROSSINGS)
                 a_c = contact_radius_from_particles(run.state, run.const)
-                a_geo = math.sqrt(2 * 200e-6 * d * 1e-6 - (d * 1e-6) ** 2)
+                a_geo = section_radius(d * 1e-6)
                 row = {"case": f"tabor:h{h:g}:d{d:g}", "contact": mode, "h_um": h, "depth_um": d,
                        "force_N": run.force_N, "a_c_um": a_c * 1e6, "a_geometric_um": a_geo * 1e6,
                        "p_over_sigma_y": run.force_N / (math.pi * a_c**2) / sigma_y,

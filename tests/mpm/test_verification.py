@@ -26,6 +26,7 @@ from plough.mpm.indentation import (
     hertz_force,
     hertz_scene,
     hold_at_depth,
+    section_radius,
     tabor_scene,
 )
 from plough.mpm.io import energy_balance
@@ -128,7 +129,7 @@ def test_tabor_indentation_at_h10():
     run = hold_at_depth(tabor_scene(10.0, depth * 1e6), settle_crossings=PLASTIC_SETTLE_CROSSINGS)
     sigma_y = TABOR_HARDNESS_PA / 3.0
     a_c = contact_radius_from_particles(run.state, run.const)
-    a_section = math.sqrt(2.0 * R_M * depth - depth**2)
+    a_section = section_radius(depth)
     assert run.state.particles.eps_p.max() > 0.01  # fully plastic under the sphere
     assert abs(run.force_drift) < 0.02  # settled
     assert 2.6 < run.force_N / (math.pi * a_c**2) / sigma_y < 3.3

@@ -12,18 +12,14 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import time
 from dataclasses import replace
 
-import numpy as np
-
-from plough.mpm import contact, solver
 from plough.mpm.indentation import (
-    AVERAGE_CROSSINGS,
-    R_M,
     TABOR_HARDNESS_PA,
     contact_radius_from_particles,
     crossing_steps,
+    hold_at_depth,
+    section_radius,
     tabor_scene,
 )
 
@@ -39,35 +35,20 @@ def run(spec: str) -> dict:
                 cfl=float(opts.get("cfl", d.cfl)), dilatation=opts.get("dil", d.dilatation))
     s = replace(scene.sliding, press_speed_fraction=float(opts.get("press", 0.25)))  # the scenes' default press
     scene = replace(scene, discretisation=d, sliding=s)
-    state, const = solver.init(scene)
-    state.sphere.centre[0] = 0.5 * scene.domain.length_m
-    crossing = crossing_steps(scene, const.dt)
-    window = max(1, int(AVERAGE_CROSSINGS * crossing))
-    settle = float(opts.get("settle", 12.0))
-    state.sphere.settle_left = max(solver.SETTLE_STEPS, int(settle * crossing), 2 * window)
-    fz, press_steps = [], None
-    t0 = time.perf_counter()
-    while state.sphere.phase != "slide":
-        solver.step(state, const)
-        out = state.work.contact_out
-        fz.append(const.symmetry_factor * (out[contact.OUT_FN + 2] + out[contact.OUT_FT + 2]))
-        if press_steps is None and state.sphere.phase == "settle":
-            press_steps = state.step
-    fz = np.asarray(fz)
+    r = hold_at_depth(scene, settle_crossings=float(opts.get("settle", 12.0)))
+    fz, press_steps, crossing = r.forces_N, r.press_steps, crossing_steps(scene, r.const.dt)
     sigma_y = TABOR_HARDNESS_PA / 3.0
-    a_c = contact_radius_from_particles(state, const)
-    a_sec = math.sqrt(2 * R_M * depth * 1e-6 - (depth * 1e-6) ** 2)
-    force = float(fz[-window:].mean())
+    a_c = contact_radius_from_particles(r.state, r.const)
+    a_sec = section_radius(depth * 1e-6)
     # the held force in windows of one crossing after the press, to see the relaxation
     held = fz[press_steps:]
     series = [float(held[i:i + crossing].mean()) for i in range(0, held.size - crossing + 1, crossing)]
-    p = state.particles
-    pressure = -p.stress[:, :3].sum(axis=1) / 3.0
-    return {"case": spec, "h_um": float(h), "dt_s": const.dt, "crossing_steps": crossing, "press_steps": press_steps,
-            "steps": state.step, "wall_s": time.perf_counter() - t0, "force_N": force,
-            "drift": force / float(fz[-2 * window:-window].mean()) - 1.0, "a_c_um": a_c * 1e6,
-            "p_true_over_sigma_y": force / (math.pi * a_c**2) / sigma_y,
-            "p_section_over_sigma_y": force / (math.pi * a_sec**2) / sigma_y,
+    pressure = -r.state.particles.stress[:, :3].sum(axis=1) / 3.0
+    return {"case": spec, "h_um": float(h), "dt_s": r.const.dt, "crossing_steps": crossing,
+            "press_steps": press_steps, "steps": r.steps, "wall_s": r.wall_s, "force_N": r.force_N,
+            "drift": r.force_drift, "a_c_um": a_c * 1e6,
+            "p_true_over_sigma_y": r.force_N / (math.pi * a_c**2) / sigma_y,
+            "p_section_over_sigma_y": r.force_N / (math.pi * a_sec**2) / sigma_y,
             "force_at_press_end_N": float(fz[press_steps - 1]), "held_by_crossing_N": series,
             "max_pressure_over_sigma_y": float(pressure.max() / sigma_y)}
 

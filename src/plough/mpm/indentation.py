@@ -56,15 +56,22 @@ def hertz_force(depth_m: float, radius_m: float = R_M, youngs_Pa: float = E_PA, 
 QUASI_STATIC_PRESS_FRACTION = 0.01
 
 
+def section_radius(depth_m: float, radius_m: float = R_M) -> float:
+    """Radius of the sphere's section at the original surface, ``depth_m`` below the top of the sphere, m."""
+    return math.sqrt(2.0 * radius_m * depth_m - depth_m**2)
+
+
 def _indentation_scene(name: str, substrate, h_um: float, depth_um: float, domain_um: float, dilatation: str,
-                       contact_mode: str, particles_per_cell: int, press_speed_fraction: float = 0.25) -> Scene:
+                       contact_mode: str, particles_per_cell: int, press_speed_fraction: float | None = None) -> Scene:
+    sliding = {"distance_um": 100, "control": "displacement", "depth_um": depth_um}
+    if press_speed_fraction is not None:  # otherwise the scene's default press
+        sliding["press_speed_fraction"] = press_speed_fraction
     return Scene.from_dict({
         "name": name, "load_N": 1.0, "sphere": {"radius_um": R_M * 1e6},
         "layers": {"substrate": substrate},
         "interface": {"model": "proportional", "f": 0.0},
         "domain": {"radius_um": domain_um, "length_um": 2 * domain_um, "symmetric": True},
-        "sliding": {"distance_um": 100, "control": "displacement", "depth_um": depth_um,
-                    "press_speed_fraction": press_speed_fraction},
+        "sliding": sliding,
         "discretisation": {"particle_size_um": h_um, "particles_per_cell": particles_per_cell, "cfl": 0.3,
                            "mass_scaling": 1e6, "dilatation": dilatation, "contact": contact_mode},
     })
@@ -99,6 +106,8 @@ class Indentation:
     wall_s: float
     closest_centre_m: float  # over the run, the closest a particle centre came to the sphere's surface (< 0: inside)
     contact_area_xy_m2: float  # the contact's own projected area (nodes or particles), full body, mean like the force
+    forces_N: np.ndarray  # the full-body normal force of every step, N
+    press_steps: int  # the steps the press took: forces_N[press_steps:] is the hold
     state: solver.State
     const: solver.Constants
 
@@ -141,6 +150,7 @@ def hold_at_depth(scene: Scene, settle_crossings: float = SETTLE_CROSSINGS) -> I
     window = max(1, int(AVERAGE_CROSSINGS * crossing))
     state.sphere.settle_left = max(solver.SETTLE_STEPS, int(settle_crossings * crossing), 2 * window)
     fz, area = [], []
+    press_steps = 0
     closest = math.inf
     t0 = time.perf_counter()
     while state.sphere.phase != "slide":  # press to the depth, then settle
@@ -150,11 +160,14 @@ def hold_at_depth(scene: Scene, settle_crossings: float = SETTLE_CROSSINGS) -> I
         area.append(const.symmetry_factor * out[contact.OUT_AREA_XY])
         # ACC_PENETRATION: the deepest a particle centre lies inside the sphere (negative: the closest outside)
         closest = min(closest, -float(state.work.acc[:, solver.transfers.ACC_PENETRATION].max()))
+        if not press_steps and state.sphere.phase == "settle":
+            press_steps = state.step
     force = float(np.mean(fz[-window:]))
     return Indentation(force_N=force, force_std_N=float(np.std(fz[-window:])),
                        force_drift=force / float(np.mean(fz[-2 * window:-window])) - 1.0,
                        steps=state.step, wall_s=time.perf_counter() - t0, closest_centre_m=closest,
-                       contact_area_xy_m2=float(np.mean(area[-window:])), state=state, const=const)
+                       contact_area_xy_m2=float(np.mean(area[-window:])), forces_N=np.asarray(fz),
+                       press_steps=press_steps, state=state, const=const)
 
 
 @dataclass
