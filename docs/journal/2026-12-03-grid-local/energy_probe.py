@@ -25,5 +25,6 @@ for v in ds.data_vars:
 n = ds.external_work.size
 for i in range(0, n, max(1, n // 25)):
     w, p = float(ds.external_work[i]), float(ds.plastic_work[i])
-    print(f"{i} W {w:.3e} plastic {p:.3e} ratio {p / max(w, 1e-30):.3f} Fz {float(ds.Fz[i]):.3f} "
-          f"depth {float(ds.depth[i]) * 1e6:.2f} um")
+    x_um, fz, depth_um = float(ds.sliding_distance[i]) * 1e6, float(ds.Fz[i]), float(ds.depth[i]) * 1e6
+    print(f"{i} x {x_um:.1f} um W {w:.3e} plastic {p:.3e} ratio {p / max(w, 1e-30):.3f} Fz {fz:.3f} "
+          f"depth {depth_um:.2f} um")
