@@ -172,10 +172,11 @@ def test_grid_contact_area_grows_under_interface_shear_and_grid_local_does_not()
     not grow (3,822 / 3,841 um^2) and mu_sh is 1.16x the analytical value (docs/journal/2026-12-03-grid-local.md).
     Asserted: the grid contact's area at least 1.2x larger at f = 1, the local contact's unchanged by f within 5%
     and its mu_sh within 25% of the analytical tau Axy / Fn."""
-    runs = {(mode, f): simulate(_workflow_example("uncoated", 10.0, f, mode), progress=False)
-            for mode in ("grid", "grid_local") for f in (0.0, 1.0)}
+    scenes = {(mode, f): _workflow_example("uncoated", 10.0, f, mode) for mode in ("grid", "grid_local")
+              for f in (0.0, 1.0)}
+    runs = {key: simulate(scene, progress=False) for key, scene in scenes.items()}
     area = {key: float(ds.contact_area_xy[ds.contact_area_xy.size // 2:].mean()) for key, ds in runs.items()}
-    scene = _workflow_example("uncoated", 10.0, 1.0, "grid_local")
+    scene = scenes["grid_local", 1.0]
     hs = representative_hardness(scene.layers.substrate)
     mu_sh = float(ploughing(scene.load_N, scene.sphere.radius_m, 0.0, hs, hs, f=1.0).mu_sh)
     assert float(runs["grid_local", 0.0].mu_sh) == 0.0
