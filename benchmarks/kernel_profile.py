@@ -34,9 +34,9 @@ from plough.mpm import contact, solver, transfers
 from plough.mpm.scene import Scene
 
 ROOT = Path(__file__).resolve().parents[1]
-KERNELS = [(transfers, "p2g"), (transfers, "grid_update"), (contact, "scatter_contact_stress"),
-           (contact, "sphere_contact"), (transfers, "mirror_ghosts"), (transfers, "g2p_kinematics"),
-           (transfers, "grid_dilatation"), (transfers, "g2p_update")]
+KERNELS = [(transfers, "scatter_pressure"), (transfers, "p2g"), (transfers, "grid_update"),
+           (contact, "scatter_contact_stress"), (contact, "sphere_contact"), (transfers, "mirror_ghosts"),
+           (transfers, "g2p_kinematics"), (transfers, "grid_dilatation"), (transfers, "g2p_update")]
 
 
 def bytes_per_particle_step(n_particles: int, n_nodes: int, n_chunks: int) -> dict[str, float]:
@@ -49,10 +49,11 @@ def bytes_per_particle_step(n_particles: int, n_nodes: int, n_chunks: int) -> di
     update) also write and read the grid velocity at the particle (6) and read x again (3). The
     grid: P2G writes n_chunks copies of 4 values per node, the grid update reads them and writes m
     and v (4), the dilatation projection writes and reads n_chunks copies of 2 values and writes
-    the nodal dilatation (1), G2P reads v and the dilatation (4).
+    the nodal dilatation (1), G2P reads v and the dilatation (4). The pressure's projection before P2G
+    reads x, the stress's diagonal, vol0, J and mass (9) and moves the grid as the dilatation's does.
     """
-    particle = 8 * (24 + 28 + 22 + 9)
-    grid = 8 * n_nodes * (n_chunks * 4 * 2 + 4 + n_chunks * 2 * 2 + 1 + 4) / n_particles
+    particle = 8 * (24 + 28 + 22 + 9 + 9)
+    grid = 8 * n_nodes * (n_chunks * 4 * 2 + 4 + 2 * (n_chunks * 2 * 2 + 1) + 4) / n_particles
     return {"particle_bytes": particle, "grid_bytes": grid, "total_bytes": particle + grid}
 
 

@@ -42,7 +42,7 @@ TINY = {
     "outputs": {"steady_window": [0.5, 1.0], "records": 40},
 }
 #: Inertia-dominated variant that blows up within a few hundred steps (a particle is flung off the grid).
-UNSTABLE = {"sliding": {"distance_um": 200, "speed_m_s": 50.0}, "discretisation": {"particle_size_um": 10, "cfl": 0.6}}
+UNSTABLE = {"sliding": {"distance_um": 200, "speed_m_s": 50.0}, "discretisation": {"particle_size_um": 10, "cfl": 0.5}}
 
 
 def scene_dict(**parts):

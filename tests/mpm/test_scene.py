@@ -239,7 +239,7 @@ def test_bad_input_raises_value_error_naming_the_parameter(case):
 
 def test_bad_input_in_constructors():
     with pytest.raises(ValueError, match=r"discretisation\.cfl"):
-        Discretisation(cfl=0.61)
+        Discretisation(cfl=0.51)
     with pytest.raises(ValueError, match=r"domain\.radius_m"):
         Domain(radius_m=-1.0)
     with pytest.raises(ValueError, match=r"sliding\.speed_m_s"):

@@ -651,6 +651,68 @@ def test_g2p_with_projection_moves_J_with_the_projected_dilatation_and_keeps_the
     np.testing.assert_allclose(s1[:, 3:], s0[:, 3:], rtol=0, atol=1e-9 * np.abs(s0[:, 3:]).max())
 
 
+def internal_force_power(stress, x, v, vol0, J, mass, grid_v, dt, n_chunks, project):
+    """sum_i f_i . v_i of P2G's internal force (its impulse channels over dt) on the nodal velocities grid_v,
+    with the particles' own pressure (project 0) or the projected one (project 1, after scatter_pressure)."""
+    n = x.shape[0]
+    G = grid_of(ORIGIN, DX, SHAPE, n_chunks)
+    P = moving(x, v, np.zeros((n, 3, 3)), stress, vol0, J, mass)
+    if project:
+        tr.scatter_pressure(P, G, whole(n, SHAPE))
+        tr.grid_dilatation(G, whole(n, SHAPE))
+    tr.p2g(P, G, dt, whole(n, SHAPE), project)
+    return float((G.buf[:, :, 4:7].sum(0) * grid_v[:, :3]).sum()) / dt
+
+
+@pytest.mark.parametrize("n_chunks", [1, 3])
+def test_projected_pressure_makes_the_internal_force_work_conjugate_to_the_projected_dilatation(n_chunks):
+    """The stress update works with L_bar (C with the projected dilatation as its trace), so the internal force
+    must do -sum_p V_p sigma_p : L_bar_p on the same nodal velocities, or the scheme creates or destroys
+    energy. With the projected pressure in P2G it does, to round-off; with each particle's own pressure it does
+    -sum V sigma : C instead (the MLS identity), which differs for a pressure that varies between particles."""
+    rng, x, v, vol0, J, mass = random_particles(n=400, seed=21)
+    n = x.shape[0]
+    stress = random_sym_stress(rng, n)
+    grid_v = np.hstack([rng.normal(0.0, 0.1, (int(np.prod(SHAPE)), 3))] * 2)
+    tr_p, _, d_bar = projection_reference(grid_v, x, mass)
+    nodes, w = weights_reference(x)
+    rel = node_positions()[nodes] - x[:, None, :]
+    C = 4.0 / DX**2 * np.einsum("pk,pkd,pke->pde", w, grid_v[nodes, :3], rel)  # L_p of the kinematics
+    L_bar = C + ((d_bar - tr_p) / 3.0)[:, None, None] * np.eye(3)
+    s0, s1, s2, s3, s4, s5 = stress.T
+    sigma = np.stack([np.stack([s0, s5, s4], -1), np.stack([s5, s1, s3], -1), np.stack([s4, s3, s2], -1)], 1)
+    vol = vol0 * J
+    power_update = float(np.einsum("p,pde,pde->", vol, sigma, L_bar))  # what the stress update takes
+    power_own = float(np.einsum("p,pde,pde->", vol, sigma, C))
+    scale = float(np.einsum("p,pde,pde->", vol, np.abs(sigma), np.abs(C)))
+    dt = 1e-8
+    projected = internal_force_power(stress, x, v, vol0, J, mass, grid_v, dt, n_chunks, 1)
+    own = internal_force_power(stress, x, v, vol0, J, mass, grid_v, dt, n_chunks, 0)
+    assert projected == pytest.approx(-power_update, rel=0, abs=1e-10 * scale)
+    assert own == pytest.approx(-power_own, rel=0, abs=1e-10 * scale)
+    assert abs(power_own - power_update) > 1e-3 * scale  # the two differ: the test can tell them apart
+
+
+def test_projected_pressure_of_a_uniform_pressure_is_that_pressure():
+    """A uniform stress projects onto itself: P2G with the projected pressure gives the same grid (the
+    projection is a mass-weighted mean of V p / m = p / rho, taken back with each particle's density)."""
+    rng, x, v, vol0, J, mass = random_particles(n=300, seed=22)
+    n = x.shape[0]
+    rho = 7000.0
+    mass = rho * vol0 * J  # one density: the projection's weights m / V are then uniform
+    stress = np.tile(rng.normal(0.0, 1e8, 6), (n, 1))
+    grids = []
+    for project in (0, 1):
+        G = grid_of(ORIGIN, DX, SHAPE, 2)
+        P = moving(x, v, np.zeros((n, 3, 3)), stress, vol0, J, mass)
+        if project:
+            tr.scatter_pressure(P, G, whole(n, SHAPE))
+            tr.grid_dilatation(G, whole(n, SHAPE))
+        tr.p2g(P, G, 1e-8, whole(n, SHAPE), project)
+        grids.append(G.buf.sum(0))
+    np.testing.assert_allclose(grids[1], grids[0], rtol=0, atol=1e-12 * np.abs(grids[0]).max())
+
+
 def test_uniform_dilatation_passes_the_projection_unchanged():
     """An affine velocity field has the same tr L at every particle: projecting it changes nothing."""
     rng, x, _, vol0, J0, mass = random_particles(n=300, seed=13)

@@ -69,10 +69,11 @@ _UNIT_SUFFIXES = {"_um": ("_m", 1e-6), "_mm": ("_m", 1e-3), "_MPa": ("_Pa", 1e6)
 
 #: Largest CFL number accepted. Explicit MPM with quadratic B-splines is stable below ~1 for the
 #: elastic wave, but the load control is not: on the 1 N stability scene the mean normal force is
-#: 1.18 / 1.23 / 1.24 x the load at CFL 0.6 / 0.8 / 0.9 (0.91 at 0.3) with the surface-share contact
-#: (docs/journal/2026-11-22-stability-matrix-and-cfl-limit.md), so above 0.6 a run would complete with a
-#: load it was not asked for.
-CFL_MAX = 0.6
+#: 0.95 / 1.14 / 1.22 x the load at CFL 0.3 / 0.5 / 0.6 with the pressure projected as the dilatation
+#: (1.18 / 1.23 / 1.24 at CFL 0.6 / 0.8 / 0.9 before; docs/journal/2026-11-22-stability-matrix-and-cfl-limit.md,
+#: docs/journal/2026-12-03-consistent-pressure.md), so above 0.5 a run would complete with a load more than 20%
+#: from the one it was asked for.
+CFL_MAX = 0.5
 #: largest accepted inertia number ms rho v^2 / H (softest layer): at 8.7 (mass scaling 1e8 at
 #: 0.1 m/s) the mean force was twice the load; at 0.09 (the paper's settings, hard substrate)
 #: inertia moved mu by 1.6% (benchmarks/stability_matrix.py, docs/journal/2026-11-22-timestep-and-transfer.md); the

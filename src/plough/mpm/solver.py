@@ -2,7 +2,9 @@
 
 One step (model.md section 2):
 
-1. P2G: particle mass, momentum and stress divergence to the grid (APIC/MLS).
+1. P2G: particle mass, momentum and stress divergence to the grid (APIC/MLS); with the projected
+   dilatation, the pressure in the stress divergence is projected the same way first (so that the
+   internal force does the work the stress update takes: no energy made or lost).
 2. Grid update: nodal velocities with the internal force; fixed curved surface, mirror plane
    (exact: nodes at +y also get their ghosts' contributions, ghosts mirror them after contact).
 3. Contact: the rigid sphere on the nodes inside it, traction-limited interface shear (eq. 8);
@@ -358,7 +360,10 @@ def step(s: State, c: Constants) -> None:
     :mod:`plough.mpm.bundles`)."""
     update_active_zone(s, c)
     P, G, S, Z, w = s.particles, grid_data(s, c), sphere_data(s, c), s.zone.ranges, s.work
-    transfers.p2g(P, G, c.dt, Z)  # 1. P2G
+    if c.project_dilatation:  # 1. P2G, with the pressure projected as the dilatation is
+        transfers.scatter_pressure(P, G, Z)
+        transfers.grid_dilatation(G, Z)
+    transfers.p2g(P, G, c.dt, Z, c.project_dilatation)
     transfers.grid_update(G, Z)  # 2. grid velocities, boundary conditions
     if c.contact_mode == "particle":  # 3. contact: the sphere on the near particles, through their nodes
         contact.particle_contact(P, G, S, Z, c.contact_law, s.step, c.dt, w.last_push_p, w.contact_out)

@@ -19,10 +19,15 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
   two particles per cell) against three velocity unknowns per node, the discrete velocity field
   cannot deform at constant volume and the block is far too stiff under the sphere (the coated
   reference scene at h = 20 / 10 um: dp 1.36 / 3.69 um without, 4.07 / 12.99 um with the
-  projection). The projection conserves sum_p m_p d_p exactly. It is F-bar-like, not B-bar: it
-  enters the stress update only, and P2G's internal force still uses each particle's own
-  gradient, so the work dt sum_p V_p p_p (d_bar_p - d_p) of the pressure on the difference is in
-  no energy term (the energy balance of the tests still closes within 3%).
+  projection). The projection conserves sum_p m_p d_p exactly. The pressure is projected with the
+  same operator (its adjoint) before P2G, so that the internal force does the work the stress
+  update takes (a B-bar scheme): pi_i = sum_p w_ip V_p p_p / m_i, and the force takes each
+  particle's deviatoric stress with p_bar_p = (m_p / V_p) sum_i w_ip pi_i, so that
+  sum_p V_p p_bar_p d_p = sum_p V_p p_p d_bar_p exactly. With each particle's own pressure in the
+  force the work of the pressure on d_bar_p - d_p went into no energy term and was not small: on
+  the uncoated reference scene at f = 0, h = 5 um, it created 0.6 of the sphere's work, dissipated
+  as plastic work while the sphere rose under its load
+  (docs/journal/2026-12-03-consistent-pressure.md).
   flip = 0 is APIC. APIC drops the part of the velocity field an affine field cannot hold on
   every transfer: a numerical dissipation per step, so the more steps a slide takes the more of
   the sphere's work it eats (41% at CFL 0.075 on the frictionless reference scene) and the
@@ -95,25 +100,35 @@ def _chunked_stencil_setup(G, Z):
 
 
 @njit(cache=True, parallel=True, fastmath=TRANSFER_FASTMATH)
-def p2g(P, G, dt, Z):
+def p2g(P, G, dt, Z, project=0):
     """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
 
     Reads P.x, v, C, stress, vol0, J, mass of the active particles Z.p_lo <= p < Z.p_hi and the grid's
-    geometry. Writes G.buf[c, node, 0:7] = (mass, momentum x, y, z, and the internal-force impulse x,
-    y, z already in that momentum) of chunk c, zeroing the active nodes Z.n_lo <= node < Z.n_hi first.
-    Race-free: chunk c owns G.buf[c].
+    geometry; if ``project`` is 1 also G.div, the nodal pressure per unit mass of ``scatter_pressure`` and
+    ``grid_dilatation``: the internal force then takes each particle's deviatoric stress with the projected
+    pressure p_bar = (m / V) sum_i w_ip G.div[i] (the module docstring says why). Writes G.buf[c, node, 0:7] =
+    (mass, momentum x, y, z, and the internal-force impulse x, y, z already in that momentum) of chunk c,
+    zeroing the active nodes Z.n_lo <= node < Z.n_hi first. Race-free: chunk c owns G.buf[c].
     """
-    x, v, C, stress, vol0, J, mass = P.x, P.v, P.C, P.stress, P.vol0, P.J, P.mass
+    x, v, C, stress, vol0, J, mass, div = P.x, P.v, P.C, P.stress, P.vol0, P.J, P.mass, G.div
     p_lo, n, n_chunks, ny, nz, dx, inv_dx, dinv = _chunked_stencil_setup(G, Z)
     for c in prange(n_chunks):
         buf = G.buf[c]
         buf[Z.n_lo:Z.n_hi, :] = 0.0
         for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
             m = mass[p]
-            k_stress = -dt * vol0[p] * J[p] * dinv
+            vol = vol0[p] * J[p]
+            k_stress = -dt * vol * dinv
             # the stress in locals: the grid stores below may alias the stress array as far as the compiler
             # knows, and would make it reload them at every node
             s0, s1, s2, s3, s4, s5 = stress[p, 0], stress[p, 1], stress[p, 2], stress[p, 3], stress[p, 4], stress[p, 5]
+            st = stencil(x, p, G.origin, inv_dx)
+            if project:
+                # sigma_mean + p_bar: the particle's own mean stress out, the projected pressure in
+                shift = (s0 + s1 + s2) / 3.0 + (m / vol) * _gather_at(div, st, ny, nz)
+                s0 -= shift
+                s1 -= shift
+                s2 -= shift
             # affine momentum matrix Q = m C - dt V D^-1 sigma
             q00 = m * C[p, 0, 0] + k_stress * s0
             q11 = m * C[p, 1, 1] + k_stress * s1
@@ -125,7 +140,6 @@ def p2g(P, G, dt, Z):
             q01 = m * C[p, 0, 1] + k_stress * s5
             q10 = m * C[p, 1, 0] + k_stress * s5
             mv0, mv1, mv2 = m * v[p, 0], m * v[p, 1], m * v[p, 2]
-            st = stencil(x, p, G.origin, inv_dx)
             # the x and y parts of each sum are taken once per (a, b) row of three nodes, in the order the sums
             # are written in (w = (wx wy) wz, (mv + q d0 + q d1) + q d2): the same round-off as per node
             for a in range(3):
@@ -253,13 +267,46 @@ def mirror_ghosts(G, Z):
         grid_v[node, 2] = grid_v[partner, 2]
 
 
+@njit(cache=True, inline="always")
+def _scatter_mass_and(buf, st, ny, nz, dx, m, t):
+    """buf[node, 0] += w m and buf[node, 1] += w t over the stencil ``st``'s 27 nodes: the scatter of a
+    projection (the dilatation's, t = m tr L; the pressure's, t = V p)."""
+    for a in range(3):
+        for b in range(3):
+            row, wab, _, _ = stencil_row_weight(st, a, b, ny, nz, dx)
+            for cc in range(3):
+                w = wab * st.wz[cc]
+                buf[row + cc, 0] += w * m
+                buf[row + cc, 1] += w * t
+
+
+@njit(cache=True, parallel=True)
+def scatter_pressure(P, G, Z):
+    """Scatter the particles' mass and volume times pressure for the pressure's projection (before P2G).
+
+    Reads P.x, stress, vol0, J, mass of the active particles Z.p_lo <= p < Z.p_hi; writes G.buf[c, node, 0] =
+    sum w m and G.buf[c, node, 1] = sum w V p (p = -tr sigma / 3) over chunk c's particles (the split of P2G
+    and the kinematics), zeroing those two channels of the active nodes Z.n_lo <= node < Z.n_hi first;
+    ``grid_dilatation`` then forms the nodal pressure per unit mass. Race-free: chunk c owns G.buf[c].
+    """
+    x, stress, vol0, J, mass = P.x, P.stress, P.vol0, P.J, P.mass
+    p_lo, n, n_chunks, ny, nz, dx, inv_dx, dinv = _chunked_stencil_setup(G, Z)
+    for c in prange(n_chunks):
+        buf = G.buf[c]
+        buf[Z.n_lo:Z.n_hi, 0:2] = 0.0
+        for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
+            _scatter_mass_and(buf, stencil(x, p, G.origin, inv_dx), ny, nz, dx, mass[p],
+                              -vol0[p] * J[p] * (stress[p, 0] + stress[p, 1] + stress[p, 2]) / 3.0)
+
+
 @njit(cache=True, parallel=True)
 def grid_dilatation(G, Z):
-    """Nodal dilatation rate d_i = (sum w m d) / m_i from the chunk copies of the ``g2p_kinematics`` scatter.
+    """Nodal dilatation rate d_i = (sum w m d) / m_i from the chunk copies of the ``g2p_kinematics`` scatter
+    (before P2G, from those of ``scatter_pressure``: the pressure per unit mass pi_i = (sum w V p) / m_i).
 
     Reads G.buf[:, node, 0:2] of the active nodes Z.n_lo <= node < Z.n_hi; writes their
     G.div[node] (0 where no mass). With the mirror plane a
-    node also sums its ghost's contributions (the dilatation is even in y), so ghost and partner
+    node also sums its ghost's contributions (dilatation and pressure are even in y), so ghost and partner
     hold the same value and the half domain projects like the full one. Each node is owned by one
     iteration: race-free.
     """
@@ -363,15 +410,7 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
             Cp[2, 1] = dinv * b21
             Cp[2, 2] = dinv * b22
             if scatter_dilatation:
-                wm = mass[p]
-                wt = wm * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2])
-                for a in range(3):
-                    for b in range(3):
-                        row, wab, _, _ = stencil_row_weight(st, a, b, ny, nz, dx)
-                        for cc in range(3):
-                            w = wab * st.wz[cc]
-                            buf[row + cc, 0] += w * wm
-                            buf[row + cc, 1] += w * wt
+                _scatter_mass_and(buf, st, ny, nz, dx, mass[p], mass[p] * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2]))
 
 
 @njit(cache=True, parallel=True)
@@ -466,7 +505,12 @@ def g2p_update(P, G, M, S, Z, dt, project, v_grid, L_buf, acc, block):
 @njit(cache=True, inline="always")
 def _gather_scalar(field, x, p, origin, inv_dx, ny, nz):
     """sum_i w_ip field[i] at particle p (quadratic B-spline weights)."""
-    st = stencil(x, p, origin, inv_dx)
+    return _gather_at(field, stencil(x, p, origin, inv_dx), ny, nz)
+
+
+@njit(cache=True, inline="always")
+def _gather_at(field, st, ny, nz):
+    """sum_i w_i field[i] over the 27 nodes of the stencil ``st``."""
     total = 0.0
     for a in range(3):
         for b in range(3):
