@@ -590,41 +590,43 @@ def weights_reference(x, origin=ORIGIN, dx=DX, shape=SHAPE):
     return np.stack(nodes, axis=1), np.stack(weights, axis=1)
 
 
-def projection_reference(grid_v, x, mass):
-    """Per particle: tr L_p, the lumped projection d_i = sum w m tr / m_i and d_bar_p = sum w d_i."""
+def projection_reference(grid_v, x, vol):
+    """Per particle: tr L_p, the lumped projection d_i = sum w V tr / V_i and d_bar_p = sum w d_i (V the particles'
+    current volumes)."""
     nodes, w = weights_reference(x)
     rel = node_positions()[nodes] - x[:, None, :]  # (n, 27, 3)
     tr_p = 4.0 / DX**2 * np.einsum("pk,pkd,pkd->p", w, grid_v[nodes, :3], rel)
     n_nodes = grid_v.shape[0]
-    m_i = np.bincount(nodes.ravel(), (w * mass[:, None]).ravel(), n_nodes)
-    mt_i = np.bincount(nodes.ravel(), (w * (mass * tr_p)[:, None]).ravel(), n_nodes)
+    m_i = np.bincount(nodes.ravel(), (w * vol[:, None]).ravel(), n_nodes)
+    mt_i = np.bincount(nodes.ravel(), (w * (vol * tr_p)[:, None]).ravel(), n_nodes)
     d_i = np.divide(mt_i, m_i, out=np.zeros(n_nodes), where=m_i > 0)
     return tr_p, d_i, (w * d_i[nodes]).sum(1)
 
 
 @pytest.mark.parametrize("n_chunks", [1, 3])
-def test_dilatation_projection_matches_reference_and_conserves_mass_weighted_dilatation(n_chunks):
+def test_dilatation_projection_matches_reference_and_conserves_the_volume_rate(n_chunks):
     """The kernels give the slow reference's nodal field and the particles' tr L; gathered back
-    from the kernels' nodal field, sum_p m_p d_bar_p = sum_p m_p tr L_p, and the norm shrinks."""
-    rng, x, _, _, _, mass = random_particles(n=500, seed=11)
+    from the kernels' nodal field, sum_p V_p d_bar_p = sum_p V_p tr L_p, and the norm shrinks."""
+    rng, x, _, vol0, J, _ = random_particles(n=500, seed=11)
+    vol = vol0 * J
     grid_v = rng.normal(0.0, 0.1, (int(np.prod(SHAPE)), 6))
     G = grid_of(ORIGIN, DX, SHAPE, n_chunks, v=grid_v, div=np.full(grid_v.shape[0], np.nan))
     G.buf[:] = 1.0  # stale content must not leak in
     grid_div = G.div
     n = x.shape[0]
     C = np.zeros((n, 3, 3))
-    tr.g2p_kinematics(particles_of(n, x=x, C=C, mass=mass), G, np.zeros((n, 3)), 0.0, 1, whole(n, SHAPE))
+    tr.g2p_kinematics(particles_of(n, x=x, C=C, vol0=vol0, J=J), G, np.zeros((n, 3)), 0.0, 1, whole(n, SHAPE))
     tr.grid_dilatation(G, whole(n, SHAPE))
-    tr_ref, d_ref, _ = projection_reference(grid_v, x, mass)
+    tr_ref, d_ref, _ = projection_reference(grid_v, x, vol)
     scale = np.abs(d_ref).max()
     np.testing.assert_allclose(grid_div, d_ref, rtol=0, atol=1e-12 * scale)
     tr_p = np.trace(C, axis1=1, axis2=2)  # the kernel's own tr L
     np.testing.assert_allclose(tr_p, tr_ref, rtol=0, atol=1e-12 * np.abs(tr_ref).max())
     nodes, w = weights_reference(x)
     d_bar = (w * grid_div[nodes]).sum(1)  # the kernels' nodal field gathered back
-    assert (mass * d_bar).sum() == pytest.approx((mass * tr_p).sum(), rel=1e-10, abs=1e-12 * scale * mass.sum())
-    # both steps are weighted means, so (Jensen) the mass-weighted norm can only shrink; a random field shrinks
-    assert (mass * d_bar**2).sum() < 0.9 * (mass * tr_p**2).sum()
+    assert (vol * d_bar).sum() == pytest.approx((vol * tr_p).sum(), rel=1e-10, abs=1e-12 * scale * vol.sum())
+    # both steps are weighted means, so (Jensen) the volume-weighted norm can only shrink; a random field shrinks
+    assert (vol * d_bar**2).sum() < 0.9 * (vol * tr_p**2).sum()
 
 
 def test_g2p_with_projection_moves_J_with_the_projected_dilatation_and_keeps_the_deviator():
@@ -632,7 +634,7 @@ def test_g2p_with_projection_moves_J_with_the_projected_dilatation_and_keeps_the
     n = x.shape[0]
     grid_v = np.hstack([rng.normal(0.0, 0.05, (int(np.prod(SHAPE)), 3))] * 2)
     dt = 1e-7
-    tr_p, _, d_bar = projection_reference(grid_v, x, mass)
+    tr_p, _, d_bar = projection_reference(grid_v, x, vol0 * J0)
     runs = {}
     for project in (0, 1):
         xs, C, stress, J = x.copy(), np.zeros((n, 3, 3)), np.zeros((n, 6)), J0.copy()
@@ -656,6 +658,7 @@ def internal_force_power(stress, x, v, vol0, J, mass, grid_v, dt, n_chunks, proj
     with the particles' own pressure (project 0) or the projected one (project 1, after scatter_pressure)."""
     n = x.shape[0]
     G = grid_of(ORIGIN, DX, SHAPE, n_chunks)
+    G.buf[:] = 1.0  # stale content must not leak in
     P = moving(x, v, np.zeros((n, 3, 3)), stress, vol0, J, mass)
     if project:
         tr.scatter_pressure(P, G, whole(n, SHAPE))
@@ -674,7 +677,7 @@ def test_projected_pressure_makes_the_internal_force_work_conjugate_to_the_proje
     n = x.shape[0]
     stress = random_sym_stress(rng, n)
     grid_v = np.hstack([rng.normal(0.0, 0.1, (int(np.prod(SHAPE)), 3))] * 2)
-    tr_p, _, d_bar = projection_reference(grid_v, x, mass)
+    tr_p, _, d_bar = projection_reference(grid_v, x, vol0 * J)
     nodes, w = weights_reference(x)
     rel = node_positions()[nodes] - x[:, None, :]
     C = 4.0 / DX**2 * np.einsum("pk,pkd,pke->pde", w, grid_v[nodes, :3], rel)  # L_p of the kinematics
@@ -694,12 +697,12 @@ def test_projected_pressure_makes_the_internal_force_work_conjugate_to_the_proje
 
 
 def test_projected_pressure_of_a_uniform_pressure_is_that_pressure():
-    """A uniform stress projects onto itself: P2G with the projected pressure gives the same grid (the
-    projection is a mass-weighted mean of V p / m = p / rho, taken back with each particle's density)."""
+    """A uniform stress projects onto itself, whatever the particles' densities (a coating on a substrate): P2G
+    with the projected pressure gives the same grid. The projection is a volume-weighted mean; a mass-weighted one
+    would give p rho_p / <rho> where the density changes."""
     rng, x, v, vol0, J, mass = random_particles(n=300, seed=22)
     n = x.shape[0]
-    rho = 7000.0
-    mass = rho * vol0 * J  # one density: the projection's weights m / V are then uniform
+    mass = np.where(x[:, 2] > x[:, 2].mean(), 7140.0, 7850.0) * vol0 * J  # zinc on steel
     stress = np.tile(rng.normal(0.0, 1e8, 6), (n, 1))
     grids = []
     for project in (0, 1):

@@ -204,7 +204,7 @@ class Work:
     last_push_p: np.ndarray  # per-particle step of the last normal push (particle contact)
     acc: np.ndarray
     contact_out: np.ndarray
-    grid_div: np.ndarray  # projected nodal dilatation rate, 1/s
+    grid_div: np.ndarray  # the projected nodal pressure (Pa) before P2G, the projected dilatation rate (1/s) after G2P
     L_buf: np.ndarray  # per-chunk scratch for the projected velocity gradient
     v_grid: np.ndarray  # (n, 3) grid velocity at each particle, m/s: what it is advected with
     external_work: float = 0.0

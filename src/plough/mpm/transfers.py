@@ -13,17 +13,19 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
   with v_i^old the nodal velocity before the internal force, boundary conditions and contact.
 - Projected dilatation (a B-bar / F-bar treatment of volumetric locking, after Telikicherla and
   Moutsanidis 2024): the volumetric strain rate d_p = tr L_p is replaced by its lumped L2
-  projection on the grid, d_i = sum_p w_ip m_p d_p / m_i, d_bar_p = sum_i w_ip d_i, and
+  projection on the grid, d_i = sum_p w_ip V_p d_p / V_i (V_i = sum_p w_ip V_p), d_bar_p = sum_i w_ip d_i, and
   L_bar_p = L_p + (d_bar_p - d_p) I / 3 drives J and the pressure (the deviator and the spin are
   L_p's). Plastic flow is isochoric: with one dilatation constraint per particle (8 per cell at
   two particles per cell) against three velocity unknowns per node, the discrete velocity field
   cannot deform at constant volume and the block is far too stiff under the sphere (the coated
   reference scene at h = 20 / 10 um: dp 1.36 / 3.69 um without, 4.07 / 12.99 um with the
-  projection). The projection conserves sum_p m_p d_p exactly. The pressure is projected with the
-  same operator (its adjoint) before P2G, so that the internal force does the work the stress
-  update takes (a B-bar scheme): pi_i = sum_p w_ip V_p p_p / m_i, and the force takes each
-  particle's deviatoric stress with p_bar_p = (m_p / V_p) sum_i w_ip pi_i, so that
-  sum_p V_p p_bar_p d_p = sum_p V_p p_p d_bar_p exactly. With each particle's own pressure in the
+  projection). The projection conserves sum_p V_p d_p (the rate of the body's volume) exactly. The
+  pressure is projected with the same operator before P2G, so that the internal force does the work
+  the stress update takes (a B-bar scheme): p_i = sum_p w_ip V_p p_p / V_i, and the force takes each
+  particle's deviatoric stress with p_bar_p = sum_i w_ip p_i, so that sum_p V_p p_bar_p d_p =
+  sum_p V_p p_p d_bar_p exactly; the volume weights (not mass weights) keep a uniform pressure and a
+  uniform dilatation unchanged across a change of density (a coating on a substrate). With each
+  particle's own pressure in the
   force the work of the pressure on d_bar_p - d_p went into no energy term and was not small: on
   the uncoated reference scene at f = 0, h = 5 um, it created 0.6 of the sphere's work, dissipated
   as plastic work while the sphere rose under its load
@@ -104,9 +106,9 @@ def p2g(P, G, dt, Z, project=0):
     """Scatter particle mass and momentum (with dt * internal force) to per-chunk grid copies.
 
     Reads P.x, v, C, stress, vol0, J, mass of the active particles Z.p_lo <= p < Z.p_hi and the grid's
-    geometry; if ``project`` is 1 also G.div, the nodal pressure per unit mass of ``scatter_pressure`` and
+    geometry; if ``project`` is 1 also G.div, the nodal pressure of ``scatter_pressure`` and
     ``grid_dilatation``: the internal force then takes each particle's deviatoric stress with the projected
-    pressure p_bar = (m / V) sum_i w_ip G.div[i] (the module docstring says why). Writes G.buf[c, node, 0:7] =
+    pressure p_bar = sum_i w_ip G.div[i] (the module docstring says why). Writes G.buf[c, node, 0:7] =
     (mass, momentum x, y, z, and the internal-force impulse x, y, z already in that momentum) of chunk c,
     zeroing the active nodes Z.n_lo <= node < Z.n_hi first. Race-free: chunk c owns G.buf[c].
     """
@@ -125,7 +127,7 @@ def p2g(P, G, dt, Z, project=0):
             st = stencil(x, p, G.origin, inv_dx)
             if project:
                 # sigma_mean + p_bar: the particle's own mean stress out, the projected pressure in
-                shift = (s0 + s1 + s2) / 3.0 + (m / vol) * _gather_at(div, st, ny, nz)
+                shift = (s0 + s1 + s2) / 3.0 + _gather_at(div, st, ny, nz)
                 s0 -= shift
                 s1 -= shift
                 s2 -= shift
@@ -268,44 +270,45 @@ def mirror_ghosts(G, Z):
 
 
 @njit(cache=True, inline="always")
-def _scatter_mass_and(buf, st, ny, nz, dx, m, t):
-    """buf[node, 0] += w m and buf[node, 1] += w t over the stencil ``st``'s 27 nodes: the scatter of a
-    projection (the dilatation's, t = m tr L; the pressure's, t = V p)."""
+def _scatter_volume_and(buf, st, ny, nz, dx, vol, t):
+    """buf[node, 0] += w vol and buf[node, 1] += w t over the stencil ``st``'s 27 nodes: the scatter of a
+    projection (the dilatation's, t = V tr L; the pressure's, t = V p)."""
     for a in range(3):
         for b in range(3):
             row, wab, _, _ = stencil_row_weight(st, a, b, ny, nz, dx)
             for cc in range(3):
                 w = wab * st.wz[cc]
-                buf[row + cc, 0] += w * m
+                buf[row + cc, 0] += w * vol
                 buf[row + cc, 1] += w * t
 
 
 @njit(cache=True, parallel=True)
 def scatter_pressure(P, G, Z):
-    """Scatter the particles' mass and volume times pressure for the pressure's projection (before P2G).
+    """Scatter the particles' volume and volume times pressure for the pressure's projection (before P2G).
 
-    Reads P.x, stress, vol0, J, mass of the active particles Z.p_lo <= p < Z.p_hi; writes G.buf[c, node, 0] =
-    sum w m and G.buf[c, node, 1] = sum w V p (p = -tr sigma / 3) over chunk c's particles (the split of P2G
+    Reads P.x, stress, vol0, J of the active particles Z.p_lo <= p < Z.p_hi; writes G.buf[c, node, 0] =
+    sum w V and G.buf[c, node, 1] = sum w V p (p = -tr sigma / 3) over chunk c's particles (the split of P2G
     and the kinematics), zeroing those two channels of the active nodes Z.n_lo <= node < Z.n_hi first;
-    ``grid_dilatation`` then forms the nodal pressure per unit mass. Race-free: chunk c owns G.buf[c].
+    ``grid_dilatation`` then forms the nodal pressure. Race-free: chunk c owns G.buf[c].
     """
-    x, stress, vol0, J, mass = P.x, P.stress, P.vol0, P.J, P.mass
-    p_lo, n, n_chunks, ny, nz, dx, inv_dx, dinv = _chunked_stencil_setup(G, Z)
+    x, stress, vol0, J = P.x, P.stress, P.vol0, P.J
+    p_lo, n, n_chunks, ny, nz, dx, inv_dx, _ = _chunked_stencil_setup(G, Z)
     for c in prange(n_chunks):
         buf = G.buf[c]
         buf[Z.n_lo:Z.n_hi, 0:2] = 0.0
         for p in range(p_lo + c * n // n_chunks, p_lo + (c + 1) * n // n_chunks):
-            _scatter_mass_and(buf, stencil(x, p, G.origin, inv_dx), ny, nz, dx, mass[p],
-                              -vol0[p] * J[p] * (stress[p, 0] + stress[p, 1] + stress[p, 2]) / 3.0)
+            vol = vol0[p] * J[p]
+            _scatter_volume_and(buf, stencil(x, p, G.origin, inv_dx), ny, nz, dx, vol,
+                                -vol * (stress[p, 0] + stress[p, 1] + stress[p, 2]) / 3.0)
 
 
 @njit(cache=True, parallel=True)
 def grid_dilatation(G, Z):
-    """Nodal dilatation rate d_i = (sum w m d) / m_i from the chunk copies of the ``g2p_kinematics`` scatter
-    (before P2G, from those of ``scatter_pressure``: the pressure per unit mass pi_i = (sum w V p) / m_i).
+    """Nodal dilatation rate d_i = (sum w V d) / V_i from the chunk copies of the ``g2p_kinematics`` scatter
+    (before P2G, from those of ``scatter_pressure``: the nodal pressure p_i = (sum w V p) / V_i).
 
     Reads G.buf[:, node, 0:2] of the active nodes Z.n_lo <= node < Z.n_hi; writes their
-    G.div[node] (0 where no mass). With the mirror plane a
+    G.div[node] (0 where no material). With the mirror plane a
     node also sums its ghost's contributions (dilatation and pressure are even in y), so ghost and partner
     hold the same value and the half domain projects like the full one. Each node is owned by one
     iteration: race-free.
@@ -314,34 +317,34 @@ def grid_dilatation(G, Z):
     n_chunks = grid_buf.shape[0]
     ny, nz = G.shape[1], G.shape[2]
     for node in prange(Z.n_lo, Z.n_hi):
-        m = 0.0
+        vol = 0.0
         t = 0.0
         for c in range(n_chunks):
-            m += grid_buf[c, node, 0]
+            vol += grid_buf[c, node, 0]
             t += grid_buf[c, node, 1]
         partner = mirror_partner(node, ny, nz, mirror_j0)
         if partner >= 0:
             for c in range(n_chunks):
-                m += grid_buf[c, partner, 0]
+                vol += grid_buf[c, partner, 0]
                 t += grid_buf[c, partner, 1]
-        grid_div[node] = t / m if m > 0.0 else 0.0
+        grid_div[node] = t / vol if vol > 0.0 else 0.0
 
 
 @njit(cache=True, parallel=True, fastmath=TRANSFER_FASTMATH)
 def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
     """Gather the particle velocities and velocity gradients; scatter the dilatation for its projection.
 
-    Reads G.v (0:3 new, 3:6 before the internal force), P.x, P.v (FLIP share ``flip``) and P.mass
+    Reads G.v (0:3 new, 3:6 before the internal force), P.x, P.v (FLIP share ``flip``) and P.vol0, P.J
     of the active particles Z.p_lo <= p < Z.p_hi. Writes their P.v (the blended update), P.C (= L_p,
     the APIC velocity gradient) and v_grid (sum_i w v_i, the velocity the particle is advected with).
-    If ``scatter_dilatation`` is 1 also writes G.buf[c, node, 0] = sum w m and
-    G.buf[c, node, 1] = sum w m tr L over chunk c's particles (zeroing those two channels of
+    If ``scatter_dilatation`` is 1 also writes G.buf[c, node, 0] = sum w V and
+    G.buf[c, node, 1] = sum w V tr L over chunk c's particles (zeroing those two channels of
     the active nodes Z.n_lo <= node < Z.n_hi first; the P2G content is no longer needed), for
     ``grid_dilatation``. The active particles' stencils must lie in the node range (the solver's
     positions check keeps them there). Race-free: particle p writes only its own entries, chunk c
     only G.buf[c].
     """
-    x, v, C, mass, grid_v = P.x, P.v, P.C, P.mass, G.v
+    x, v, C, vol0, J, grid_v = P.x, P.v, P.C, P.vol0, P.J, G.v
     p_lo, n, n_chunks, ny, nz, dx, inv_dx, dinv = _chunked_stencil_setup(G, Z)
     for c in prange(n_chunks):
         buf = G.buf[c]
@@ -410,7 +413,8 @@ def g2p_kinematics(P, G, v_grid, flip, scatter_dilatation, Z):
             Cp[2, 1] = dinv * b21
             Cp[2, 2] = dinv * b22
             if scatter_dilatation:
-                _scatter_mass_and(buf, st, ny, nz, dx, mass[p], mass[p] * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2]))
+                vol = vol0[p] * J[p]
+                _scatter_volume_and(buf, st, ny, nz, dx, vol, vol * (Cp[0, 0] + Cp[1, 1] + Cp[2, 2]))
 
 
 @njit(cache=True, parallel=True)
