@@ -25,10 +25,9 @@ the velocity gradient drives the stress update (eq. 6.1) and the particles are a
   particle's deviatoric stress with p_bar_p = sum_i w_ip p_i, so that sum_p V_p p_bar_p d_p =
   sum_p V_p p_p d_bar_p exactly; the volume weights (not mass weights) keep a uniform pressure and a
   uniform dilatation unchanged across a change of density (a coating on a substrate). With each
-  particle's own pressure in the
-  force the work of the pressure on d_bar_p - d_p went into no energy term and was not small: on
-  the uncoated reference scene at f = 0, h = 5 um, it created 0.6 of the sphere's work, dissipated
-  as plastic work while the sphere rose under its load
+  particle's own pressure in the force the work of the pressure on d_bar_p - d_p went into no
+  energy term and was not small: on the uncoated reference scene at f = 0, h = 5 um, it created
+  0.6 of the sphere's work, dissipated as plastic work while the sphere rose under its load
   (docs/journal/2026-12-03-consistent-pressure.md).
   flip = 0 is APIC. APIC drops the part of the velocity field an affine field cannot hold on
   every transfer: a numerical dissipation per step, so the more steps a slide takes the more of
