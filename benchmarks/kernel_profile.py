@@ -47,13 +47,15 @@ def bytes_per_particle_step(n_particles: int, n_nodes: int, n_chunks: int) -> di
     values) and writes x, v, C, stress, J, near (about 22; eps_p, temperature, sigma_y0 and
     deps_last only where a particle flows, not counted); its two passes (kinematics, then the
     update) also write and read the grid velocity at the particle (6) and read x again (3). The
-    grid: P2G writes n_chunks copies of 4 values per node, the grid update reads them and writes m
-    and v (4), the dilatation projection writes and reads n_chunks copies of 2 values and writes
-    the nodal dilatation (1), G2P reads v and the dilatation (4). The pressure's projection before P2G
-    reads x, the stress's diagonal, vol0, J and mass (9) and moves the grid as the dilatation's does.
+    grid: P2G writes n_chunks copies of 7 values per node (mass, momentum, the internal force's impulse),
+    the grid update reads them and writes m and v (7: the velocity before and after the internal force),
+    each of the two projections (the pressure's before P2G, the dilatation's after the kinematics)
+    writes and reads n_chunks copies of 2 values and writes the nodal value (1), P2G reads the nodal
+    pressure (1) and G2P reads v and the dilatation (7). The pressure's projection reads x, the
+    stress's diagonal, vol0 and J (8) of each particle.
     """
-    particle = 8 * (24 + 28 + 22 + 9 + 9)
-    grid = 8 * n_nodes * (n_chunks * 4 * 2 + 4 + 2 * (n_chunks * 2 * 2 + 1) + 4) / n_particles
+    particle = 8 * (24 + 28 + 22 + 9 + 8)
+    grid = 8 * n_nodes * (n_chunks * 7 * 2 + 7 + 2 * (n_chunks * 2 * 2 + 1) + 1 + 7) / n_particles
     return {"particle_bytes": particle, "grid_bytes": grid, "total_bytes": particle + grid}
 
 
