@@ -118,14 +118,35 @@ def _touched_smoke_outputs(work: Path) -> None:
     assert counts == {}, counts  # a complete state: nothing to do
 
 
+@pytest.fixture(scope="module")
+def touched_smoke(tmp_path_factory) -> Path:
+    """A fresh checkout after a complete smoke run (:func:`_touched_smoke_outputs`), made once for the module's
+    DAG cases: each copies it (:func:`_copy_of`) before changing anything."""
+    work = _project_copy(tmp_path_factory.mktemp("touched") / "wf")
+    _touched_smoke_outputs(work)
+    return work
+
+
+def _copy_of(touched: Path, dest: Path, *, datasets_current: bool = False) -> Path:
+    """A copy of a checkout, its files' times kept (as ``cp -a`` does), Snakemake's records included. The
+    datasets' and figures' inputs name the package sources by absolute path, so in the copy those jobs are
+    planned again ("Set of input files has changed"); ``datasets_current`` records them as made here."""
+    shutil.copytree(touched, dest, symlinks=True)
+    if datasets_current:
+        out = _snakemake(dest, "--touch", "--configfile=config/smoke.yaml", timeout=300)
+        assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+        counts, _ = _planned(dest)
+        assert counts == {}, counts
+    return dest
+
+
 def _append(path: Path, text: str) -> None:
     path.write_text(path.read_text() + text)
 
 
 # ----------------------------------------------------------------------------- 1. identity by physics
-def test_a_comment_docstring_or_figure_change_reruns_no_mpm_run_a_solver_change_reruns_all(tmp_path):
-    work = _project_copy(tmp_path / "wf")
-    _touched_smoke_outputs(work)
+def test_a_comment_docstring_or_figure_change_reruns_no_mpm_run_a_solver_change_reruns_all(touched_smoke, tmp_path):
+    work = _copy_of(touched_smoke, tmp_path / "wf")
 
     # a figure's code (comment and code): figures may redraw, no MPM run reruns
     _append(work / "src/plough/figures/style.py", "\n# a comment added by a test\nTEST_CONSTANT = 1\n")
@@ -153,12 +174,12 @@ def test_a_comment_docstring_or_figure_change_reruns_no_mpm_run_a_solver_change_
     assert "Params have changed" in text or "params" in text.lower()
 
 
-def test_copied_runs_rerun_nothing_in_a_fresh_checkout(tmp_path):
+def test_copied_runs_rerun_nothing_in_a_fresh_checkout(touched_smoke, tmp_path):
     """The README's reuse advice: copy results/runs/ (with their times, as cp -a or rsync -a do) into a
     fresh checkout of the same solver; only datasets and figures are made."""
-    old = _project_copy(tmp_path / "old", fresh=False)
-    _touched_smoke_outputs(old)
-    time.sleep(1.1)  # the fresh checkout is newer than every run file
+    old = touched_smoke  # read only
+    newest_run = max(p.stat().st_mtime for p in (old / "results/runs").iterdir())
+    time.sleep(max(0.0, newest_run + 1.1 - time.time()))  # the fresh checkout is newer than every run file
     new = _project_copy(tmp_path / "new")
     shutil.copytree(old / "results/runs", new / "results/runs")  # copy2: times kept
     counts, _ = _planned(new)
@@ -166,9 +187,8 @@ def test_copied_runs_rerun_nothing_in_a_fresh_checkout(tmp_path):
     assert counts.get("mpm_dataset", 0) == len(MPM_FIGURES), counts
 
 
-def test_a_lubricant_constant_reruns_its_runs_and_only_the_datasets_that_read_them(tmp_path):
-    work = _project_copy(tmp_path / "wf")
-    _touched_smoke_outputs(work)
+def test_a_lubricant_constant_reruns_its_runs_and_only_the_datasets_that_read_them(touched_smoke, tmp_path):
+    work = _copy_of(touched_smoke, tmp_path / "wf", datasets_current=True)
     cfg = yaml.safe_load((work / "config/smoke.yaml").read_text())
     cfg["mpm"]["real_materials"]["lubricants"]["dx56"]["Cp"] = 1.5
     (work / "config/smoke.yaml").write_text(yaml.safe_dump(cfg))
@@ -309,13 +329,12 @@ def test_the_refinement_decision_refuses_a_corrupt_coarser_run(tmp_path):
     assert not out.exists()
 
 
-def test_the_workflow_remakes_a_broken_run_file_the_way_the_error_says(tmp_path):
+def test_the_workflow_remakes_a_broken_run_file_the_way_the_error_says(touched_smoke, tmp_path):
     """The error's advice, --forcerun <file>, plans that run and what reads it. (Deleting the file would
     not do: Snakemake remakes a missing file only for an output that needs it.)"""
     from plough.study import runfiles
 
-    work = _project_copy(tmp_path / "wf")
-    _touched_smoke_outputs(work)
+    work = _copy_of(touched_smoke, tmp_path / "wf")
     rid = matrix.figure_runs(SMOKE, "fig15")[1]
     path = f"results/runs/{rid}.nc"
     (work / path).write_bytes(b"garbage")
