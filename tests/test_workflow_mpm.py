@@ -54,12 +54,22 @@ def _job_counts(text: str) -> dict[str, int]:
     return counts
 
 
-@pytest.mark.slow
-def test_smoke_fig15_runs_extrapolates_draws_and_caches(tmp_path):
-    work = _project_copy(tmp_path)
-    targets = ("results/datasets/fig15.nc", "results/figures/fig15.png")
-    out = _snakemake(work, "--configfile=config/smoke.yaml", *targets)
+FIG15_TARGETS = ("results/datasets/fig15.nc", "results/figures/fig15.png")
+
+
+@pytest.fixture(scope="module")
+def smoke_fig15(tmp_path_factory) -> Path:
+    """The smoke Fig. 15 made once (its runs, dataset and figure) in a copy of the project, for the tests
+    that read it or start from its runs."""
+    work = _project_copy(tmp_path_factory.mktemp("fig15"))
+    out = _snakemake(work, "--configfile=config/smoke.yaml", *FIG15_TARGETS)
     assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+    return work
+
+
+@pytest.mark.slow
+def test_smoke_fig15_runs_extrapolates_draws_and_caches(smoke_fig15):
+    work, targets = smoke_fig15, FIG15_TARGETS
 
     mpm = SMOKE["mpm"]
     real = mpm["real_materials"]
@@ -122,7 +132,7 @@ def test_full_matrix_dry_run_schedules_every_run_once(tmp_path):
 
 
 @pytest.mark.slow
-def test_smoke_refinement_makes_the_finest_run_only_where_the_coarser_sizes_do_not_agree(tmp_path):
+def test_smoke_refinement_makes_the_finest_run_only_where_the_coarser_sizes_do_not_agree(smoke_fig15, tmp_path):
     """Refinement only where needed end to end on Fig. 15 (the checkpoint mpm_refine): the coarser runs first,
     then a tolerance between the points' two-size uncertainties, so that some finest runs are needed and some
     not. Before running, `snakemake -n` lists every decision and no gated finest run; each decision follows
@@ -130,13 +140,18 @@ def test_smoke_refinement_makes_the_finest_run_only_where_the_coarser_sizes_do_n
     says which points were extrapolated from two sizes; a picture's finest run always runs."""
     from plough.study import skipping
 
-    work = _project_copy(tmp_path)
     sizes = matrix.particle_sizes_um(SMOKE)
     finest_ids = [r for r in matrix.figure_runs(SMOKE, "fig15") if r.endswith(f"_h{matrix.fmt(sizes[-1])}")]
     stems = [r.rsplit("_h", 1)[0] for r in finest_ids]
     coarse = [f"results/runs/{s}_h{matrix.fmt(h)}.nc" for s in stems for h in sizes[:2]]
+    # the coarser runs as the smoke Fig. 15 made them (its files and Snakemake's records of them); no finest run
+    work = tmp_path / "wf"
+    shutil.copytree(smoke_fig15, work, symlinks=True)
+    for path in (*FIG15_TARGETS, "results/figures/fig15.pdf", *(f"results/runs/{r}.nc" for r in finest_ids)):
+        (work / path).unlink()
     out = _snakemake(work, "--configfile=config/smoke.yaml", *coarse)
     assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
+    assert "Nothing to be done" in out.stdout + out.stderr  # made once, in the fixture
 
     def worst(stem: str) -> float:
         runs = [xr.load_dataset(work / f"results/runs/{stem}_h{matrix.fmt(h)}.nc") for h in sizes[:2]]
