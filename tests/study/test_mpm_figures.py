@@ -139,6 +139,18 @@ def run_files(tmp_path_factory):
     return paths
 
 
+_SMOKE_DATASETS: dict[tuple[str, int], xr.Dataset] = {}
+
+
+def smoke_dataset(figure: str, run_files: dict) -> xr.Dataset:
+    """``build_dataset(SMOKE, figure, run_files)`` for the module's unchanged run files, built once per figure
+    (most tests read the same datasets); each caller gets its own deep copy."""
+    key = (figure, id(run_files))
+    if key not in _SMOKE_DATASETS:
+        _SMOKE_DATASETS[key] = build_dataset(SMOKE, figure, run_files)
+    return _SMOKE_DATASETS[key].copy(deep=True)
+
+
 def _written(ds: xr.Dataset, tmp_path: Path) -> xr.Dataset:
     """Through the workflow's atomic writer (which refuses undeclared NaN) and back."""
     path = write_netcdf_atomic(ds, tmp_path / "figure.nc")
@@ -200,7 +212,7 @@ def _check_extrapolation(ds, o, sel, sig, suffix="", noisy=False):
 
 # ----------------------------------------------------------------------------- sweep figures
 def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path):
-    ds = build_dataset(SMOKE, "fig15", run_files)
+    ds = smoke_dataset("fig15", run_files)
     real = MPM["real_materials"]
     loads = [float(x) for x in real["loads_N"]]
     assert ds["dp"].dims == ("material", "load_N", "h")
@@ -254,7 +266,7 @@ def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path)
 
 
 def test_fig11_has_two_panels_with_suffixed_variables(run_files, tmp_path):
-    ds = build_dataset(SMOKE, "fig11", run_files)
+    ds = smoke_dataset("fig11", run_files)
     rp = MPM["rigid_plastic"]
     rs, ts = rp["ratio_sweep"], rp["thickness_sweep"]
     assert ds.attrs["panels"] == "a,b"
@@ -311,7 +323,7 @@ def test_thickness_panel_keeps_every_mark_in_view_and_the_key_off_the_marks(run_
 
     from plough.figures import mpm as mpm_figures
 
-    ds = build_dataset(SMOKE, "fig11", run_files)
+    ds = smoke_dataset("fig11", run_files)
     high = float(ds["dp_b"].max()) * 7.0  # an extrapolated mark far above every per-size value
     ds["dp_h0_b"][{"coating": 0, "thickness_um": 1}] = high
     ds["dp_h0_b"][{"coating": 1, "thickness_um": 1}] = -0.5 * high  # an extrapolation below zero
@@ -358,7 +370,7 @@ def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(run_files, tmp_path, m
 
     from plough.figures import mpm as mpm_figures
 
-    ds = _written(build_dataset(SMOKE, "fig13", run_files), tmp_path)
+    ds = _written(smoke_dataset("fig13", run_files), tmp_path)
     fig = _drawn_figure("fig13", ds, monkeypatch)
     assert len(fig.axes) == 6
     series = {"_a": ("interface", "hardness_ratio"), "_b": ("coating", "thickness_um")}
@@ -387,7 +399,7 @@ def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(run_files, tmp_path, m
     assert "docs/journal/2026-12-02-interface-shear-split.md" in notes[0]
     plt.close(fig)
 
-    fig = _drawn_figure("fig11", _written(build_dataset(SMOKE, "fig11", run_files), tmp_path), monkeypatch)
+    fig = _drawn_figure("fig11", _written(smoke_dataset("fig11", run_files), tmp_path), monkeypatch)
     assert [ax.get_ylabel() for ax in fig.axes] == [mpm_figures.QUANTITY["dp"][0]] * 2
     assert [ax.get_title() for ax in fig.axes] == ["(a) vs hardness ratio H~", "(b) vs coating thickness t"]
     assert not [t for t in fig.legends[0].get_texts() if t.get_text().startswith("note:")]
@@ -401,13 +413,13 @@ def test_fig13_png_holds_the_three_rows(run_files, tmp_path):
     sizes = {}
     for figure in ("fig11", "fig13"):
         png = tmp_path / f"{figure}.png"
-        plot(figure, _written(build_dataset(SMOKE, figure, run_files), tmp_path), [png])
+        plot(figure, _written(smoke_dataset(figure, run_files), tmp_path), [png])
         sizes[figure] = matplotlib.image.imread(png).shape[:2]
     assert sizes["fig13"][1] == sizes["fig11"][1] and sizes["fig13"][0] > 2 * sizes["fig11"][0]
 
 
 def test_fig18_thickness_panel_and_bulk_panel(run_files, tmp_path):
-    ds = build_dataset(SMOKE, "fig18", run_files)
+    ds = smoke_dataset("fig18", run_files)
     rts = MPM["real_materials"]["thickness_sweep"]
     assert ds.attrs["panels"] == "t,bulk"
     assert ds["dp_t"].dims == ("coated_system", "thickness_um", "h")
@@ -423,7 +435,7 @@ def test_fig18_thickness_panel_and_bulk_panel(run_files, tmp_path):
 
 
 def test_fig22_fits_with_the_mpm_points_of_fig21(run_files, tmp_path):
-    ds = build_dataset(SMOKE, "fig22", run_files)
+    ds = smoke_dataset("fig22", run_files)
     real = MPM["real_materials"]
     loads = [float(x) for x in real["loads_N"]]
     assert ds["mu_mpm"].dims == ("ball_diameter_mm", "mpm_load_N")
@@ -436,7 +448,7 @@ def test_fig22_fits_with_the_mpm_points_of_fig21(run_files, tmp_path):
             sel = {"ball_diameter_mm": 2 * float(r) / 1000, "mpm_load_N": load}
             assert float(ds["mu_mpm"].sel(sel)) == pytest.approx(limit("mu", sig), rel=1e-9)
             assert float(ds["mu_mpm_uncertainty"].sel(sel)) > 0
-    fig21 = build_dataset(SMOKE, "fig21", run_files)
+    fig21 = smoke_dataset("fig21", run_files)
     np.testing.assert_array_equal(ds["mu_mpm"].values, fig21["mu_h0"].values)
     assert json.loads(ds.attrs["config"])["mpm"] == json.loads(to_json(MPM))
     _draws("fig22", _written(ds, tmp_path), tmp_path)
@@ -464,7 +476,7 @@ def _finest_run(point: matrix.Point) -> str:
 
 
 def test_fig19_keeps_the_finest_run_of_its_case(run_files, tmp_path):
-    ds = build_dataset(SMOKE, "fig19", run_files)
+    ds = smoke_dataset("fig19", run_files)
     real = MPM["real_materials"]
     pic = real["picture"]
     point = matrix.real_point(real, "coated", pic["load_N"], pic["radius_um"])
@@ -491,7 +503,7 @@ def test_fig19_keeps_the_finest_run_of_its_case(run_files, tmp_path):
 
 
 def test_fig17_stacks_two_cases_of_different_size(run_files, tmp_path):
-    ds = build_dataset(SMOKE, "fig17", run_files)
+    ds = smoke_dataset("fig17", run_files)
     real = MPM["real_materials"]
     pic = real["picture"]
     assert list(ds["case"].values) == ["coated", "zinc_block"]
@@ -514,7 +526,7 @@ def test_fig17_stacks_two_cases_of_different_size(run_files, tmp_path):
 
 @pytest.mark.parametrize("figure", ["fig12", "fig14"])
 def test_picture_figures_draw(run_files, tmp_path, figure):
-    ds = build_dataset(SMOKE, figure, run_files)
+    ds = smoke_dataset(figure, run_files)
     point = matrix.figure_points(SMOKE, figure)["coated"]
     run = xr.load_dataset(run_files[_finest_run(point)])
     for name in ("midplane_x", "midplane_coating") if figure == "fig12" else ("height_map", "section_z"):
@@ -526,7 +538,7 @@ def test_picture_figures_draw(run_files, tmp_path, figure):
 
 def test_sphere_position_reaches_the_fig12_picture(run_files):
     """plot_fig12 draws the sphere from the run's attribute sphere_centre_end_m, kept per case."""
-    ds = build_dataset(SMOKE, "fig12", run_files)
+    ds = smoke_dataset("fig12", run_files)
     np.testing.assert_allclose(ds.attrs["sphere_centre_end_m_coated"], [2e-4, 0.0, 4.9e-4])
 
 
@@ -539,7 +551,7 @@ def test_result_files_from_before_the_steadiness_check_still_build(run_files, tm
         old[rid] = tmp_path / f"{rid}.nc"
         xr.load_dataset(path).drop_vars("steady").to_netcdf(old[rid])
     without = build_dataset(SMOKE, figure, old)
-    with_check = build_dataset(SMOKE, figure, run_files)
+    with_check = smoke_dataset(figure, run_files)
     assert "steady" in with_check and "steady" not in without
     xr.testing.assert_identical(without, with_check.drop_vars("steady"))
 
@@ -573,13 +585,13 @@ def test_a_mix_of_old_and_new_result_files(run_files, tmp_path):
     one_old = dict(run_files)
     one_old[finest[0]] = tmp_path / "one_old.nc"
     xr.load_dataset(run_files[finest[0]]).drop_vars("steady").to_netcdf(one_old[finest[0]])
-    assert "steady" in build_dataset(SMOKE, "fig17", run_files)
+    assert "steady" in smoke_dataset("fig17", run_files)
     assert "steady" not in build_dataset(SMOKE, "fig17", one_old)
 
 
 def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):
     reordered = dict(reversed(list(run_files.items())))
-    a = build_dataset(SMOKE, "fig16", run_files)
+    a = smoke_dataset("fig16", run_files)
     b = build_dataset(copy.deepcopy(SMOKE), "fig16", reordered)
     xr.testing.assert_identical(a, b)
 
@@ -657,7 +669,7 @@ def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
 
     from plough.figures import mpm as mpm_figures
 
-    ds = build_dataset(SMOKE, "fig15", run_files)
+    ds = smoke_dataset("fig15", run_files)
     n_bad = int((ds["steady"] == 0).sum())
     assert n_bad == len(SIZES)  # the steel at the highest load, at every size
     for data, crosses in ((ds, n_bad), (ds.drop_vars("steady"), 0)):
@@ -682,7 +694,7 @@ def test_sweep_figure_draws_the_trend_over_lighter_bars(run_files):
 
     from plough.figures import mpm as mpm_figures
 
-    ds = build_dataset(SMOKE, "fig15", run_files)
+    ds = smoke_dataset("fig15", run_files)
     fig, ax = plt.subplots()
     mpm_figures._sweep_panel(ax, ds, "dp", "")
     bars = [c.lines[2][0] for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() is None]
@@ -723,7 +735,7 @@ def test_every_mpm_figure_has_one_key_under_its_question(run_files, tmp_path, fi
     module = analytical_figures if figure == "fig22" else mpm_figures
     drawn = []
     monkeypatch.setattr(module, "save", lambda fig, outputs: drawn.append(fig))
-    module.PLOTTERS[figure](_written(build_dataset(SMOKE, figure, run_files), tmp_path), [tmp_path / "f.png"])
+    module.PLOTTERS[figure](_written(smoke_dataset(figure, run_files), tmp_path), [tmp_path / "f.png"])
     check_header(drawn[0], figure)
     import matplotlib.pyplot as plt
 
@@ -740,7 +752,7 @@ def test_sweep_figure_draws_each_runs_sampling_error(run_files):
 
     from plough.figures import mpm as mpm_figures
 
-    ds = build_dataset(SMOKE, "fig15", run_files)
+    ds = smoke_dataset("fig15", run_files)
     for quantity, scale in (("mu", 1.0), ("dp", 1e6)):
         fig, ax = plt.subplots()
         mpm_figures._sweep_panel(ax, ds, quantity, "")
