@@ -9,8 +9,10 @@
 
 The DAG cases need no MPM run: every output is created empty and ``snakemake --touch`` records it as
 made by the current workflow (its params and inputs), so a dry run (``-n``) says exactly what a change
-would rerun. They run Snakemake in a temporary copy of the project with its ``src/`` first on the
-Python path, so that an edit of the copy's package is what the workflow sees.
+would rerun. That state is made once and copied per test; the datasets' and figures' inputs name the package
+sources by absolute path, so a test that asserts which of them a change reruns first records them as made in
+its copy (``_copy_of(..., datasets_current=True)``). They run Snakemake in a temporary copy of the project
+with its ``src/`` first on the Python path, so that an edit of the copy's package is what the workflow sees.
 """
 
 from __future__ import annotations
@@ -334,7 +336,7 @@ def test_the_workflow_remakes_a_broken_run_file_the_way_the_error_says(touched_s
     not do: Snakemake remakes a missing file only for an output that needs it.)"""
     from plough.study import runfiles
 
-    work = _copy_of(touched_smoke, tmp_path / "wf")
+    work = _copy_of(touched_smoke, tmp_path / "wf", datasets_current=True)
     rid = matrix.figure_runs(SMOKE, "fig15")[1]
     path = f"results/runs/{rid}.nc"
     (work / path).write_bytes(b"garbage")
@@ -346,7 +348,9 @@ def test_the_workflow_remakes_a_broken_run_file_the_way_the_error_says(touched_s
     assert "--forcerun" in args and path in args
     counts, text = _planned(work, *[a for a in args if not a.startswith("--cores") and not a.isdigit()])
     assert counts.get("mpm_run") == 1 and path in _planned_outputs(text, "mpm_run")
-    assert "results/datasets/fig15.nc" in _planned_outputs(text, "mpm_dataset")
+    readers = {f"results/datasets/{fig}.nc" for fig in MPM_FIGURES if rid in matrix.figure_runs(SMOKE, fig)}
+    assert "results/datasets/fig15.nc" in readers
+    assert _planned_outputs(text, "mpm_dataset") == readers
 
 
 # ----------------------------------------------------------------------------- 4. a killed workflow resumes

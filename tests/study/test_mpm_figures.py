@@ -139,16 +139,19 @@ def run_files(tmp_path_factory):
     return paths
 
 
-_SMOKE_DATASETS: dict[tuple[str, int], xr.Dataset] = {}
+_SMOKE_DATASETS: dict[str, xr.Dataset] = {}
+_SMOKE_RUN_FILES: list[dict] = []  # the run files the cached datasets were built from (held: never another's)
 
 
 def smoke_dataset(figure: str, run_files: dict) -> xr.Dataset:
     """``build_dataset(SMOKE, figure, run_files)`` for the module's unchanged run files, built once per figure
     (most tests read the same datasets); each caller gets its own deep copy."""
-    key = (figure, id(run_files))
-    if key not in _SMOKE_DATASETS:
-        _SMOKE_DATASETS[key] = build_dataset(SMOKE, figure, run_files)
-    return _SMOKE_DATASETS[key].copy(deep=True)
+    if not _SMOKE_RUN_FILES or _SMOKE_RUN_FILES[0] is not run_files:
+        _SMOKE_DATASETS.clear()
+        _SMOKE_RUN_FILES[:] = [run_files]
+    if figure not in _SMOKE_DATASETS:
+        _SMOKE_DATASETS[figure] = build_dataset(SMOKE, figure, run_files)
+    return _SMOKE_DATASETS[figure].copy(deep=True)
 
 
 def _written(ds: xr.Dataset, tmp_path: Path) -> xr.Dataset:
