@@ -9,10 +9,10 @@
 
 The DAG cases need no MPM run: every output is created empty and ``snakemake --touch`` records it as
 made by the current workflow (its params and inputs), so a dry run (``-n``) says exactly what a change
-would rerun. That state is made once and copied per test; the datasets' and figures' inputs name the package
-sources by absolute path, so a test that asserts which of them a change reruns first records them as made in
-its copy (``_copy_of(..., datasets_current=True)``). They run Snakemake in a temporary copy of the project
-with its ``src/`` first on the Python path, so that an edit of the copy's package is what the workflow sees.
+would rerun. That state is made once and copied per test: a copy, being the same workflow in another place,
+plans nothing (the cheap rules name the package sources relative to the working directory). They run Snakemake
+in a temporary copy of the project with its ``src/`` first on the Python path, so that an edit of the copy's
+package is what the workflow sees.
 """
 
 from __future__ import annotations
@@ -116,8 +116,7 @@ def _touched_smoke_outputs(work: Path) -> None:
     # --forceall: every job "runs" (is touched, in the DAG's order) and is recorded with its params and inputs
     out = _snakemake(work, "--touch", "--forceall", "--configfile=config/smoke.yaml", timeout=300)
     assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
-    counts, _ = _planned(work)
-    assert counts == {}, counts  # a complete state: nothing to do
+    _assert_nothing_planned(work)  # a complete state
 
 
 @pytest.fixture(scope="module")
@@ -129,17 +128,17 @@ def touched_smoke(tmp_path_factory) -> Path:
     return work
 
 
-def _copy_of(touched: Path, dest: Path, *, datasets_current: bool = False) -> Path:
-    """A copy of a checkout, its files' times kept (as ``cp -a`` does), Snakemake's records included. The
-    datasets' and figures' inputs name the package sources by absolute path, so in the copy those jobs are
-    planned again ("Set of input files has changed"); ``datasets_current`` records them as made here."""
+def _copy_of(touched: Path, dest: Path) -> Path:
+    """A copy of a checkout elsewhere, its files' times kept (as ``cp -a`` does), Snakemake's records included:
+    the same workflow in another place, so nothing is planned in it (asserted)."""
     shutil.copytree(touched, dest, symlinks=True)
-    if datasets_current:
-        out = _snakemake(dest, "--touch", "--configfile=config/smoke.yaml", timeout=300)
-        assert out.returncode == 0, (out.stdout + out.stderr)[-4000:]
-        counts, _ = _planned(dest)
-        assert counts == {}, counts
+    _assert_nothing_planned(dest)
     return dest
+
+
+def _assert_nothing_planned(work: Path) -> None:
+    counts, _ = _planned(work)
+    assert counts == {}, counts
 
 
 def _append(path: Path, text: str) -> None:
@@ -190,7 +189,7 @@ def test_copied_runs_rerun_nothing_in_a_fresh_checkout(touched_smoke, tmp_path):
 
 
 def test_a_lubricant_constant_reruns_its_runs_and_only_the_datasets_that_read_them(touched_smoke, tmp_path):
-    work = _copy_of(touched_smoke, tmp_path / "wf", datasets_current=True)
+    work = _copy_of(touched_smoke, tmp_path / "wf")
     cfg = yaml.safe_load((work / "config/smoke.yaml").read_text())
     cfg["mpm"]["real_materials"]["lubricants"]["dx56"]["Cp"] = 1.5
     (work / "config/smoke.yaml").write_text(yaml.safe_dump(cfg))
@@ -336,7 +335,7 @@ def test_the_workflow_remakes_a_broken_run_file_the_way_the_error_says(touched_s
     not do: Snakemake remakes a missing file only for an output that needs it.)"""
     from plough.study import runfiles
 
-    work = _copy_of(touched_smoke, tmp_path / "wf", datasets_current=True)
+    work = _copy_of(touched_smoke, tmp_path / "wf")
     rid = matrix.figure_runs(SMOKE, "fig15")[1]
     path = f"results/runs/{rid}.nc"
     (work / path).write_bytes(b"garbage")

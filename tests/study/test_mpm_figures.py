@@ -139,19 +139,18 @@ def run_files(tmp_path_factory):
     return paths
 
 
-_SMOKE_DATASETS: dict[str, xr.Dataset] = {}
-_SMOKE_RUN_FILES: list[dict] = []  # the run files the cached datasets were built from (held: never another's)
+@pytest.fixture(scope="module")
+def smoke_dataset(run_files):
+    """figure -> ``build_dataset(SMOKE, figure, run_files)`` for the module's unchanged run files, built once per
+    figure (most tests read the same datasets); each call returns its own deep copy."""
+    built: dict[str, xr.Dataset] = {}
 
+    def dataset(figure: str) -> xr.Dataset:
+        if figure not in built:
+            built[figure] = build_dataset(SMOKE, figure, run_files)
+        return built[figure].copy(deep=True)
 
-def smoke_dataset(figure: str, run_files: dict) -> xr.Dataset:
-    """``build_dataset(SMOKE, figure, run_files)`` for the module's unchanged run files, built once per figure
-    (most tests read the same datasets); each caller gets its own deep copy."""
-    if not _SMOKE_RUN_FILES or _SMOKE_RUN_FILES[0] is not run_files:
-        _SMOKE_DATASETS.clear()
-        _SMOKE_RUN_FILES[:] = [run_files]
-    if figure not in _SMOKE_DATASETS:
-        _SMOKE_DATASETS[figure] = build_dataset(SMOKE, figure, run_files)
-    return _SMOKE_DATASETS[figure].copy(deep=True)
+    return dataset
 
 
 def _written(ds: xr.Dataset, tmp_path: Path) -> xr.Dataset:
@@ -214,8 +213,8 @@ def _check_extrapolation(ds, o, sel, sig, suffix="", noisy=False):
 
 
 # ----------------------------------------------------------------------------- sweep figures
-def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path):
-    ds = smoke_dataset("fig15", run_files)
+def test_fig15_per_size_values_extrapolation_and_analytical(smoke_dataset, tmp_path):
+    ds = smoke_dataset("fig15")
     real = MPM["real_materials"]
     loads = [float(x) for x in real["loads_N"]]
     assert ds["dp"].dims == ("material", "load_N", "h")
@@ -268,8 +267,8 @@ def test_fig15_per_size_values_extrapolation_and_analytical(run_files, tmp_path)
     _draws("fig15", _written(ds, tmp_path), tmp_path)
 
 
-def test_fig11_has_two_panels_with_suffixed_variables(run_files, tmp_path):
-    ds = smoke_dataset("fig11", run_files)
+def test_fig11_has_two_panels_with_suffixed_variables(smoke_dataset, tmp_path):
+    ds = smoke_dataset("fig11")
     rp = MPM["rigid_plastic"]
     rs, ts = rp["ratio_sweep"], rp["thickness_sweep"]
     assert ds.attrs["panels"] == "a,b"
@@ -314,7 +313,7 @@ def test_fig11_has_two_panels_with_suffixed_variables(run_files, tmp_path):
     _draws("fig11", _written(ds, tmp_path), tmp_path)
 
 
-def test_thickness_panel_keeps_every_mark_in_view_and_the_key_off_the_marks(run_files):
+def test_thickness_panel_keeps_every_mark_in_view_and_the_key_off_the_marks(smoke_dataset):
     """Fig. 11b: a per-size dp far above the analytical lines and the dp = t line's reach stays in view (the
     axis used to end at 1.3x the largest per-size value, hiding extrapolated marks above it); the t axis is
     linear to THICKNESS_LINEAR_UM and logarithmic beyond, starting left of t = 0; the panel has no legend of
@@ -326,7 +325,7 @@ def test_thickness_panel_keeps_every_mark_in_view_and_the_key_off_the_marks(run_
 
     from plough.figures import mpm as mpm_figures
 
-    ds = smoke_dataset("fig11", run_files)
+    ds = smoke_dataset("fig11")
     high = float(ds["dp_b"].max()) * 7.0  # an extrapolated mark far above every per-size value
     ds["dp_h0_b"][{"coating": 0, "thickness_um": 1}] = high
     ds["dp_h0_b"][{"coating": 1, "thickness_um": 1}] = -0.5 * high  # an extrapolation below zero
@@ -362,7 +361,7 @@ def _drawn_figure(figure: str, ds: xr.Dataset, monkeypatch):
     return drawn[0]
 
 
-def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(run_files, tmp_path, monkeypatch):
+def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(smoke_dataset, tmp_path, monkeypatch):
     """Issue 32: at strong interface shear the MPM's mu_sh is not expected to equal the analytical one (the
     contact grows under shear), its mu_pl is; so Fig. 13 draws mu (a, b), mu_pl (c, d) and mu_sh (e, f), each
     against H~ (left) and t (right): every panel's trend is its own quantity's h -> 0 values, its dashed lines
@@ -373,7 +372,7 @@ def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(run_files, tmp_path, m
 
     from plough.figures import mpm as mpm_figures
 
-    ds = _written(smoke_dataset("fig13", run_files), tmp_path)
+    ds = _written(smoke_dataset("fig13"), tmp_path)
     fig = _drawn_figure("fig13", ds, monkeypatch)
     assert len(fig.axes) == 6
     series = {"_a": ("interface", "hardness_ratio"), "_b": ("coating", "thickness_um")}
@@ -402,27 +401,27 @@ def test_fig13_has_a_row_for_mu_and_for_each_of_its_parts(run_files, tmp_path, m
     assert "docs/journal/2026-12-02-interface-shear-split.md" in notes[0]
     plt.close(fig)
 
-    fig = _drawn_figure("fig11", _written(smoke_dataset("fig11", run_files), tmp_path), monkeypatch)
+    fig = _drawn_figure("fig11", _written(smoke_dataset("fig11"), tmp_path), monkeypatch)
     assert [ax.get_ylabel() for ax in fig.axes] == [mpm_figures.QUANTITY["dp"][0]] * 2
     assert [ax.get_title() for ax in fig.axes] == ["(a) vs hardness ratio H~", "(b) vs coating thickness t"]
     assert not [t for t in fig.legends[0].get_texts() if t.get_text().startswith("note:")]
     plt.close(fig)
 
 
-def test_fig13_png_holds_the_three_rows(run_files, tmp_path):
+def test_fig13_png_holds_the_three_rows(smoke_dataset, tmp_path):
     """The saved PNG is the three-row figure: taller than Fig. 11's single row at the same width."""
     import matplotlib.image
 
     sizes = {}
     for figure in ("fig11", "fig13"):
         png = tmp_path / f"{figure}.png"
-        plot(figure, _written(smoke_dataset(figure, run_files), tmp_path), [png])
+        plot(figure, _written(smoke_dataset(figure), tmp_path), [png])
         sizes[figure] = matplotlib.image.imread(png).shape[:2]
     assert sizes["fig13"][1] == sizes["fig11"][1] and sizes["fig13"][0] > 2 * sizes["fig11"][0]
 
 
-def test_fig18_thickness_panel_and_bulk_panel(run_files, tmp_path):
-    ds = smoke_dataset("fig18", run_files)
+def test_fig18_thickness_panel_and_bulk_panel(smoke_dataset, tmp_path):
+    ds = smoke_dataset("fig18")
     rts = MPM["real_materials"]["thickness_sweep"]
     assert ds.attrs["panels"] == "t,bulk"
     assert ds["dp_t"].dims == ("coated_system", "thickness_um", "h")
@@ -437,8 +436,8 @@ def test_fig18_thickness_panel_and_bulk_panel(run_files, tmp_path):
     _draws("fig18", _written(ds, tmp_path), tmp_path)
 
 
-def test_fig22_fits_with_the_mpm_points_of_fig21(run_files, tmp_path):
-    ds = smoke_dataset("fig22", run_files)
+def test_fig22_fits_with_the_mpm_points_of_fig21(smoke_dataset, tmp_path):
+    ds = smoke_dataset("fig22")
     real = MPM["real_materials"]
     loads = [float(x) for x in real["loads_N"]]
     assert ds["mu_mpm"].dims == ("ball_diameter_mm", "mpm_load_N")
@@ -451,7 +450,7 @@ def test_fig22_fits_with_the_mpm_points_of_fig21(run_files, tmp_path):
             sel = {"ball_diameter_mm": 2 * float(r) / 1000, "mpm_load_N": load}
             assert float(ds["mu_mpm"].sel(sel)) == pytest.approx(limit("mu", sig), rel=1e-9)
             assert float(ds["mu_mpm_uncertainty"].sel(sel)) > 0
-    fig21 = smoke_dataset("fig21", run_files)
+    fig21 = smoke_dataset("fig21")
     np.testing.assert_array_equal(ds["mu_mpm"].values, fig21["mu_h0"].values)
     assert json.loads(ds.attrs["config"])["mpm"] == json.loads(to_json(MPM))
     _draws("fig22", _written(ds, tmp_path), tmp_path)
@@ -478,8 +477,8 @@ def _finest_run(point: matrix.Point) -> str:
     return matrix.run_id(point, min(SIZES))
 
 
-def test_fig19_keeps_the_finest_run_of_its_case(run_files, tmp_path):
-    ds = smoke_dataset("fig19", run_files)
+def test_fig19_keeps_the_finest_run_of_its_case(smoke_dataset, run_files, tmp_path):
+    ds = smoke_dataset("fig19")
     real = MPM["real_materials"]
     pic = real["picture"]
     point = matrix.real_point(real, "coated", pic["load_N"], pic["radius_um"])
@@ -505,8 +504,8 @@ def test_fig19_keeps_the_finest_run_of_its_case(run_files, tmp_path):
     _draws("fig19", _written(ds, tmp_path), tmp_path)
 
 
-def test_fig17_stacks_two_cases_of_different_size(run_files, tmp_path):
-    ds = smoke_dataset("fig17", run_files)
+def test_fig17_stacks_two_cases_of_different_size(smoke_dataset, run_files, tmp_path):
+    ds = smoke_dataset("fig17")
     real = MPM["real_materials"]
     pic = real["picture"]
     assert list(ds["case"].values) == ["coated", "zinc_block"]
@@ -528,8 +527,8 @@ def test_fig17_stacks_two_cases_of_different_size(run_files, tmp_path):
 
 
 @pytest.mark.parametrize("figure", ["fig12", "fig14"])
-def test_picture_figures_draw(run_files, tmp_path, figure):
-    ds = smoke_dataset(figure, run_files)
+def test_picture_figures_draw(smoke_dataset, run_files, tmp_path, figure):
+    ds = smoke_dataset(figure)
     point = matrix.figure_points(SMOKE, figure)["coated"]
     run = xr.load_dataset(run_files[_finest_run(point)])
     for name in ("midplane_x", "midplane_coating") if figure == "fig12" else ("height_map", "section_z"):
@@ -539,14 +538,14 @@ def test_picture_figures_draw(run_files, tmp_path, figure):
     _draws(figure, _written(ds, tmp_path), tmp_path)
 
 
-def test_sphere_position_reaches_the_fig12_picture(run_files):
+def test_sphere_position_reaches_the_fig12_picture(smoke_dataset):
     """plot_fig12 draws the sphere from the run's attribute sphere_centre_end_m, kept per case."""
-    ds = smoke_dataset("fig12", run_files)
+    ds = smoke_dataset("fig12")
     np.testing.assert_allclose(ds.attrs["sphere_centre_end_m_coated"], [2e-4, 0.0, 4.9e-4])
 
 
 @pytest.mark.parametrize("figure", ["fig15", "fig19"])
-def test_result_files_from_before_the_steadiness_check_still_build(run_files, tmp_path, figure):
+def test_result_files_from_before_the_steadiness_check_still_build(smoke_dataset, run_files, tmp_path, figure):
     """Cached runs written before io.steadiness existed have no 'steady': the figure's dataset
     is built without it (no all-missing variable), everything else unchanged."""
     old = {}
@@ -554,12 +553,12 @@ def test_result_files_from_before_the_steadiness_check_still_build(run_files, tm
         old[rid] = tmp_path / f"{rid}.nc"
         xr.load_dataset(path).drop_vars("steady").to_netcdf(old[rid])
     without = build_dataset(SMOKE, figure, old)
-    with_check = smoke_dataset(figure, run_files)
+    with_check = smoke_dataset(figure)
     assert "steady" in with_check and "steady" not in without
     xr.testing.assert_identical(without, with_check.drop_vars("steady"))
 
 
-def test_a_mix_of_old_and_new_result_files(run_files, tmp_path):
+def test_a_mix_of_old_and_new_result_files(smoke_dataset, run_files, tmp_path):
     """Some runs from before the steadiness check: a sweep keeps the flag of the others and leaves
     the old ones missing; a single-run figure drops the flag unless every case has it."""
     sweep_old = set()
@@ -588,13 +587,13 @@ def test_a_mix_of_old_and_new_result_files(run_files, tmp_path):
     one_old = dict(run_files)
     one_old[finest[0]] = tmp_path / "one_old.nc"
     xr.load_dataset(run_files[finest[0]]).drop_vars("steady").to_netcdf(one_old[finest[0]])
-    assert "steady" in smoke_dataset("fig17", run_files)
+    assert "steady" in smoke_dataset("fig17")
     assert "steady" not in build_dataset(SMOKE, "fig17", one_old)
 
 
-def test_sweep_datasets_do_not_depend_on_the_paths_order(run_files):
+def test_sweep_datasets_do_not_depend_on_the_paths_order(smoke_dataset, run_files):
     reordered = dict(reversed(list(run_files.items())))
-    a = smoke_dataset("fig16", run_files)
+    a = smoke_dataset("fig16")
     b = build_dataset(copy.deepcopy(SMOKE), "fig16", reordered)
     xr.testing.assert_identical(a, b)
 
@@ -662,7 +661,7 @@ def test_an_old_skip_marker_is_refused_with_the_command_that_remakes_it(run_file
         build_dataset(config, "fig15", paths)
 
 
-def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
+def test_sweep_figure_crosses_the_runs_that_were_not_steady(smoke_dataset):
     """The per-size points of runs with steady = 0 (the fake noisy steel runs) get a cross, once in the legend;
     without the flag (files from before the check) no cross is drawn."""
     import matplotlib
@@ -672,7 +671,7 @@ def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
 
     from plough.figures import mpm as mpm_figures
 
-    ds = smoke_dataset("fig15", run_files)
+    ds = smoke_dataset("fig15")
     n_bad = int((ds["steady"] == 0).sum())
     assert n_bad == len(SIZES)  # the steel at the highest load, at every size
     for data, crosses in ((ds, n_bad), (ds.drop_vars("steady"), 0)):
@@ -685,7 +684,7 @@ def test_sweep_figure_crosses_the_runs_that_were_not_steady(run_files):
         plt.close(fig)
 
 
-def test_sweep_figure_draws_the_trend_over_lighter_bars(run_files):
+def test_sweep_figure_draws_the_trend_over_lighter_bars(smoke_dataset):
     """Trend first: each series' extrapolated values are joined by one line in its colour, drawn above
     their bars, which are lighter and thinner than that line; the per-size values are faint; the y axis
     follows the marks and lines (zero included), not the bars."""
@@ -697,7 +696,7 @@ def test_sweep_figure_draws_the_trend_over_lighter_bars(run_files):
 
     from plough.figures import mpm as mpm_figures
 
-    ds = smoke_dataset("fig15", run_files)
+    ds = smoke_dataset("fig15")
     fig, ax = plt.subplots()
     mpm_figures._sweep_panel(ax, ds, "dp", "")
     bars = [c.lines[2][0] for c in ax.containers if c.lines[2] and c.lines[2][0].get_alpha() is None]
@@ -728,7 +727,7 @@ def test_sweep_figure_draws_the_trend_over_lighter_bars(run_files):
 
 
 @pytest.mark.parametrize("figure", [*matrix.MPM_FIGURES, "fig22"])
-def test_every_mpm_figure_has_one_key_under_its_question(run_files, tmp_path, figure, monkeypatch):
+def test_every_mpm_figure_has_one_key_under_its_question(smoke_dataset, tmp_path, figure, monkeypatch):
     """No legend inside a panel: one key for the figure, above the panels, titled with the figure's
     question in one line."""
     from plough.figures import analytical as analytical_figures
@@ -738,14 +737,14 @@ def test_every_mpm_figure_has_one_key_under_its_question(run_files, tmp_path, fi
     module = analytical_figures if figure == "fig22" else mpm_figures
     drawn = []
     monkeypatch.setattr(module, "save", lambda fig, outputs: drawn.append(fig))
-    module.PLOTTERS[figure](_written(smoke_dataset(figure, run_files), tmp_path), [tmp_path / "f.png"])
+    module.PLOTTERS[figure](_written(smoke_dataset(figure), tmp_path), [tmp_path / "f.png"])
     check_header(drawn[0], figure)
     import matplotlib.pyplot as plt
 
     plt.close(drawn[0])
 
 
-def test_sweep_figure_draws_each_runs_sampling_error(run_files):
+def test_sweep_figure_draws_each_runs_sampling_error(smoke_dataset):
     """Every per-size point gets a bar of +- its run's standard error (none where it was not estimable:
     the noisy run's dp); files without the errors draw no bars."""
     import matplotlib
@@ -755,7 +754,7 @@ def test_sweep_figure_draws_each_runs_sampling_error(run_files):
 
     from plough.figures import mpm as mpm_figures
 
-    ds = smoke_dataset("fig15", run_files)
+    ds = smoke_dataset("fig15")
     for quantity, scale in (("mu", 1.0), ("dp", 1e6)):
         fig, ax = plt.subplots()
         mpm_figures._sweep_panel(ax, ds, quantity, "")

@@ -17,8 +17,8 @@ FULL = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
 def test_a_sweep_figures_view_lists_its_gated_runs_finding_them_once(monkeypatch, figure):
     """The workflow evaluates the view of every MPM figure while it builds the DAG: finding the gated
     (skippable, failure-recordable) runs, which places every sweep point on its ladder with the analytical
-    model, is done once per view, not once per run of the figure (a dry run of the full matrix spent 66 s
-    there)."""
+    model, is done once per view, for both roles, not once per run of the figure (a dry run of the full matrix
+    spent 66 s there)."""
     calls = []
     original = matrix.finest_sweep_runs
 
@@ -30,8 +30,27 @@ def test_a_sweep_figures_view_lists_its_gated_runs_finding_them_once(monkeypatch
     view = runfiles.figure_view(FULL, figure)
     runs = matrix.figure_runs(FULL, figure)
     assert len(runs) > 10
-    assert len(calls) == 2  # skippable_runs and failure_recordable_runs, each once
+    assert len(calls) == 1  # both roles from one search (matrix.finest_run_roles)
     gated = original(FULL)
     assert view["skippable"] == [r for r in runs if r in gated]
     assert view["recordable"] == [r for r in runs if r in gated]
     assert view["skippable"]  # the full matrix gates some of this figure's finest runs
+
+
+@pytest.mark.parametrize(("tolerance", "failure", "skippable", "recordable"),
+                         [(None, "record", False, True), ({"mu": 0.05, "dp": 0.3}, "stop", True, False),
+                          (None, "stop", False, False)])
+def test_each_finest_role_follows_its_own_option(tolerance, failure, skippable, recordable):
+    config = {**FULL, "mpm": {**FULL["mpm"], "skip_finest_tolerance": tolerance, "finest_failure": failure}}
+    gated = matrix.finest_sweep_runs(config)
+    assert gated
+    s, r = matrix.finest_run_roles(config)
+    assert s == (gated if skippable else {})
+    assert r == (gated if recordable else {})
+    assert (matrix.skippable_runs(config), matrix.failure_recordable_runs(config)) == (s, r)
+
+
+def test_a_wrong_finest_failure_is_refused_by_name():
+    config = {**FULL, "mpm": {**FULL["mpm"], "finest_failure": "ignore"}}
+    with pytest.raises(ValueError, match="mpm.finest_failure = 'ignore' is unknown; allowed: record, stop"):
+        matrix.finest_run_roles(config)

@@ -8,6 +8,7 @@
 # (profiles/default, the workflow profile Snakemake reads by itself); the cheap rules take the
 # package source and their script as inputs instead, so an edit still redoes them.
 import json
+import os
 import re
 from pathlib import Path
 
@@ -18,8 +19,11 @@ from plough.mpm.scene import Scene
 from plough.study import cost, matrix
 from plough.study.runfiles import figure_view
 
-PACKAGE_SOURCES = sorted(str(p) for p in Path(workflow.basedir, "src", "plough").rglob("*.py"))
-SCRIPTS = Path(workflow.basedir, "workflow", "scripts")
+# relative to the working directory: Snakemake records a job's inputs by these names, so a checkout moved
+# or copied elsewhere (its results/ and .snakemake/ with it) plans nothing new, as absolute paths would
+PROJECT = Path(os.path.relpath(workflow.basedir))
+PACKAGE_SOURCES = sorted(str(p) for p in Path(PROJECT, "src", "plough").rglob("*.py"))
+SCRIPTS = Path(PROJECT, "workflow", "scripts")
 # the solver the jobs import (the installed plough), and the run job's own code without comments
 SOLVER_FINGERPRINT = solver_fingerprint()
 RUN_SCRIPT_FINGERPRINT = files_fingerprint([SCRIPTS / "mpm_run.py"], SCRIPTS)

@@ -20,6 +20,7 @@ import json
 import math
 import re
 from dataclasses import dataclass, field, replace
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -378,6 +379,14 @@ def _exponent(length_um: float, target: float, finest_um: float) -> int:
     return math.floor(math.log2(length_um / (target * finest_um)) + 1e-9)
 
 
+@cache
+def _expected_contact_um(layers: Layers, load_N: float, radius_m: float) -> tuple[float, float]:
+    """(a, dp) in um of the analytical model (``plough.mpm.scene.expected_contact``), computed once per
+    physical point: a workflow start asks for every point's ladder many times (datasets, gates, costs)."""
+    a_m, dp_m = expected_contact(layers, load_N, radius_m)
+    return a_m * 1e6, dp_m * 1e6
+
+
 def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     """The particle sizes of ``point``: ``mpm.ladder: paper`` (the default) runs every point at the config's
     ``particle_sizes_um``; ``relative`` runs it at those sizes times 2^k, k the largest integer at which the
@@ -404,8 +413,8 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     choice = mpm.get("ladder", LADDER_DEFAULT)
     if choice not in LADDER_CHOICES:
         raise ValueError(f"mpm.ladder = {choice!r} is unknown; allowed: {', '.join(LADDER_CHOICES)}")
-    a_m, dp_m = expected_contact(point.layers(), point.load_N, point.radius_m)
-    a, dp, t = a_m * 1e6, dp_m * 1e6, point.thickness_m * 1e6
+    a, dp = _expected_contact_um(point.layers(), point.load_N, point.radius_m)
+    t = point.thickness_m * 1e6
     if choice == "paper":
         return Ladder(paper, 1.0, a, dp, t, "paper")
     targets = mpm.get("ladder_targets")
@@ -563,25 +572,29 @@ def skippable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
     only where the point's refinement decision asks for them (``plough.study.skipping``): empty unless
     ``mpm.skip_finest_tolerance`` is set (checked here) and there are at least three sizes; never a run a
     picture (single-run figure) needs."""
-    from plough.study.skipping import tolerances
-
-    tolerance = config["mpm"].get("skip_finest_tolerance")
-    if tolerance is None:
-        return {}
-    tolerances(tolerance)
-    return finest_sweep_runs(config)
+    return finest_run_roles(config)[0]
 
 
 def failure_recordable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
     """The finest sweep runs (as :func:`finest_sweep_runs`) whose stop on the solver's instability
     error is recorded as a failure marker (``plough.study.skipping``) instead of failing the
     workflow: all of them with ``mpm.finest_failure: record`` (the default), none with ``stop``."""
+    return finest_run_roles(config)[1]
+
+
+def finest_run_roles(config: dict[str, Any]) -> tuple[dict[str, tuple[str, str]], dict[str, tuple[str, str]]]:
+    """(:func:`skippable_runs`, :func:`failure_recordable_runs`), the finest sweep runs found once for both:
+    each option is checked whatever the other says."""
+    from plough.study.skipping import tolerances
+
+    tolerance = config["mpm"].get("skip_finest_tolerance")
+    if tolerance is not None:
+        tolerances(tolerance)
     choice = config["mpm"].get("finest_failure", FINEST_FAILURE_DEFAULT)
     if choice not in FINEST_FAILURE_CHOICES:
         raise ValueError(f"mpm.finest_failure = {choice!r} is unknown; allowed: {', '.join(FINEST_FAILURE_CHOICES)}")
-    if choice != "record":
-        return {}
-    return finest_sweep_runs(config)
+    finest = finest_sweep_runs(config) if tolerance is not None or choice == "record" else {}
+    return (finest if tolerance is not None else {}), (dict(finest) if choice == "record" else {})
 
 
 def finest_sweep_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:

@@ -132,7 +132,7 @@ def figure_view(config: dict[str, Any], figure: str) -> dict[str, Any]:
         view["cases"] = {label: dataclasses.asdict(p) for label, p in matrix.figure_points(config, sweep).items()}
     else:
         view["panels"] = [dataclasses.asdict(p) for p in matrix.figure_panels(config, sweep)]
-        skippable, recordable = matrix.skippable_runs(config), matrix.failure_recordable_runs(config)
+        skippable, recordable = matrix.finest_run_roles(config)
         view["skippable"] = [r for r in runs if r in skippable]
         view["recordable"] = [r for r in runs if r in recordable]
     if figure in ("fig11", "fig13"):
