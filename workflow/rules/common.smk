@@ -20,7 +20,8 @@ from plough.study import cost, matrix
 from plough.study.runfiles import figure_view
 
 # relative to the working directory: Snakemake records a job's inputs by these names, so a checkout moved
-# or copied elsewhere (its results/ and .snakemake/ with it) plans nothing new, as absolute paths would
+# or copied elsewhere (its results/ and .snakemake/ with it) plans nothing new; absolute names would make
+# every dataset and figure look changed there ("Set of input files has changed")
 PROJECT = Path(os.path.relpath(workflow.basedir))
 PACKAGE_SOURCES = sorted(str(p) for p in Path(PROJECT, "src", "plough").rglob("*.py"))
 SCRIPTS = Path(PROJECT, "workflow", "scripts")

@@ -594,7 +594,9 @@ def finest_run_roles(config: dict[str, Any]) -> tuple[dict[str, tuple[str, str]]
     if choice not in FINEST_FAILURE_CHOICES:
         raise ValueError(f"mpm.finest_failure = {choice!r} is unknown; allowed: {', '.join(FINEST_FAILURE_CHOICES)}")
     finest = finest_sweep_runs(config) if tolerance is not None or choice == "record" else {}
-    return (finest if tolerance is not None else {}), (dict(finest) if choice == "record" else {})
+    skippable = dict(finest) if tolerance is not None else {}
+    recordable = dict(finest) if choice == "record" else {}
+    return skippable, recordable
 
 
 def finest_sweep_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
