@@ -36,6 +36,32 @@ def fig14_scene(h_um: float):
     return matrix.scene_for(point, h_um, config["mpm"]["numerics"])
 
 
+def run_quietly(scene, threads: int = 2):
+    """The run's dataset, without the progress bar or the solver's warnings."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return simulate(scene, progress=False, threads=threads)
+
+
+def measure(scene, threads: int = 2) -> dict:
+    """Run ``scene`` and keep what this entry compares: mu and its parts, the penetration under load, the residual
+    profile (mean of the sections) with its centre and where it is deepest within 1.5 expected contact radii, the
+    groove's dg / hpu / dp, the energy account, the wall time."""
+    t0 = time.perf_counter()
+    ds = run_quietly(scene, threads)
+    y, z = ds["y"].values, ds["profile_z"].values
+    a_exp, _ = scene.expected_contact()
+    near = np.abs(y) <= 1.5 * a_exp
+    deepest = int(np.nanargmin(np.where(near, z, np.nan)))
+    row = {"wall_s": time.perf_counter() - t0, "steps": int(ds.attrs["cost_steps"]),
+           "expected_contact_radius_m": a_exp, "y_deepest_m": float(y[deepest]), "z_centre_m": float(z[0]),
+           "profile_y_m": y.tolist(), "profile_z_m": [None if not np.isfinite(v) else float(v) for v in z]}
+    row.update({q: float(ds[q]) for q in ("mu", "mu_pl", "mu_sh", "penetration", "dg", "hpu", "dp",
+                                           "dp_standard_error", "max_particle_penetration", "mu_drift", "steady")})
+    row["energy_ratio"] = sum(float(ds[q][-1]) for q in ENERGY) / float(ds["external_work"][-1])
+    return row
+
+
 def main() -> None:
     ap = argparse.ArgumentParser()
     ap.add_argument("--h-um", type=float, required=True)
@@ -51,21 +77,8 @@ def main() -> None:
         scene = fig14_scene(a.h_um)
         disc = scene.discretisation
         scene = replace(scene, discretisation=replace(disc, mass_scaling=disc.mass_scaling * factor))
-        t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            ds = simulate(scene, progress=False, threads=a.threads)
-        y, z = ds["y"].values, ds["profile_z"].values
-        a_exp, _ = scene.expected_contact()
-        near = np.abs(y) <= 1.5 * a_exp
-        deepest = int(np.nanargmin(np.where(near, z, np.nan)))
         row = {"h_um": a.h_um, "ms_factor": factor, "mass_scaling": disc.mass_scaling * factor,
-               "wall_s": time.perf_counter() - t0, "steps": int(ds.attrs["cost_steps"]),
-               "expected_contact_radius_m": a_exp, "y_deepest_m": float(y[deepest]), "z_centre_m": float(z[0]),
-               "profile_y_m": y.tolist(), "profile_z_m": [None if not np.isfinite(v) else float(v) for v in z]}
-        row.update({q: float(ds[q]) for q in ("mu", "mu_pl", "mu_sh", "penetration", "dg", "hpu", "dp",
-                                               "dp_standard_error", "max_particle_penetration", "mu_drift", "steady")})
-        row["energy_ratio"] = sum(float(ds[q][-1]) for q in ENERGY) / float(ds["external_work"][-1])
+               **measure(scene, a.threads)}
         data["runs"].append(row)
         a.out.write_text(json.dumps(data, indent=1))
         print(f"h {a.h_um:g} ms x {factor:g}: mu {row['mu']:.4f} penetration {row['penetration'] * 1e6:.2f} um "

@@ -9,13 +9,10 @@ from __future__ import annotations
 
 import argparse
 import importlib.util
-import warnings
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
-
-from plough.mpm.run import simulate
 
 _spec = importlib.util.spec_from_file_location("probe", Path(__file__).with_name("probe.py"))
 probe = importlib.util.module_from_spec(_spec)
@@ -29,9 +26,7 @@ def main() -> None:
     ap.add_argument("--width-um", type=float, default=60.0)
     a = ap.parse_args()
     if not a.keep.exists():
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            simulate(probe.fig14_scene(a.h_um), progress=False, threads=2).to_netcdf(a.keep)
+        probe.run_quietly(probe.fig14_scene(a.h_um)).to_netcdf(a.keep)
     ds = xr.load_dataset(a.keep)
     y, z = ds["section_y"].values * 1e6, ds["section_z"].values * 1e6
     coat, h = ds["section_coating"].values, a.h_um

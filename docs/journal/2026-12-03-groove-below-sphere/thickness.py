@@ -11,19 +11,19 @@ Each run is written to ``--out`` as it finishes (resumable); 0 is the zinc block
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
-import time
-import warnings
 from pathlib import Path
 
-import numpy as np
 import yaml
 
 from plough.io import git_commit
-from plough.mpm.run import simulate
 from plough.study import matrix
 
 ROOT = Path(__file__).resolve().parents[3]
+_spec = importlib.util.spec_from_file_location("probe", Path(__file__).with_name("probe.py"))
+probe = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(probe)
 
 
 def main() -> None:
@@ -40,21 +40,10 @@ def main() -> None:
         if t in done:
             continue
         scene = matrix.scene_for(points[round(t)], a.h_um, config["mpm"]["numerics"])
-        t0 = time.perf_counter()
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            ds = simulate(scene, progress=False, threads=2)
-        y, z = ds["y"].values, ds["profile_z"].values
-        a_exp, _ = scene.expected_contact()
-        near = np.abs(y) <= 1.5 * a_exp
-        deepest = int(np.nanargmin(np.where(near, z, np.nan)))
-        row = {"thickness_um": t, "h_um": a.h_um, "wall_s": time.perf_counter() - t0,
-               "y_deepest_m": float(y[deepest]), "z_centre_m": float(z[0]),
-               "profile_y_m": y.tolist(), "profile_z_m": [None if not np.isfinite(v) else float(v) for v in z]}
-        row.update({q: float(ds[q]) for q in ("mu", "penetration", "dg", "hpu", "dp", "dp_standard_error", "steady")})
+        row = {"thickness_um": t, "h_um": a.h_um, **probe.measure(scene)}
         data["runs"].append(row)
         a.out.write_text(json.dumps(data, indent=1))
-        prof = " ".join(f"{v * 1e6:.1f}" for v in z[:10])
+        prof = " ".join("nan" if v is None else f"{v * 1e6:.1f}" for v in row["profile_z_m"][:10])
         print(f"t {t:g} um: mu {row['mu']:.4f} penetration {row['penetration'] * 1e6:.2f} centre "
               f"{-row['z_centre_m'] * 1e6:.2f} deepest {row['dg'] * 1e6:.2f} at y {row['y_deepest_m'] * 1e6:.0f} um "
               f"dp {row['dp'] * 1e6:.2f} wall {row['wall_s']:.0f} s | profile {prof}", flush=True)
