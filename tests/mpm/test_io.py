@@ -28,7 +28,7 @@ def _grooved_block(scene: Scene, depth_of_row):
     top = np.where(Y < 30e-6, -depth_of_row(rows), 0.0)
     x = np.stack([X.ravel(), Y.ravel(), (top - 0.5 * h).ravel()], axis=1)
     n = x.shape[0]
-    return SimpleNamespace(x=x, J=np.ones(n), vol0=np.full(n, h**3), n=n), xs
+    return SimpleNamespace(x=x, J=np.ones(n), vol0=np.full(n, h**3), z0=np.full(n, -0.5 * h), n=n), xs
 
 
 @pytest.fixture
@@ -72,13 +72,94 @@ def test_material_thrown_past_the_blocks_side_is_not_read_as_its_surface(scene):
     a, x_end = 50e-6, s.start_x_m + s.sliding.distance_m
     y, z0, sections = residual_profiles(p, s, x_end, a)
     thrown = np.array([[sections[1], s.domain.radius_m + 0.6 * s.discretisation.particle_size_m, 13e-6]])
-    q = SimpleNamespace(x=np.vstack([p.x, thrown]), J=np.ones(p.n + 1), vol0=np.append(p.vol0, p.vol0[0]), n=p.n + 1)
+    q = SimpleNamespace(x=np.vstack([p.x, thrown]), J=np.ones(p.n + 1), vol0=np.append(p.vol0, p.vol0[0]),
+                        z0=np.append(p.z0, p.z0[0]), n=p.n + 1)
     _, z1, _ = residual_profiles(q, s, x_end, a)
     np.testing.assert_array_equal(z1, z0)
     inside = q.x.copy()
     inside[-1, 1] = s.domain.radius_m - 3e-6  # the same particle inside the block's width does count
-    _, z2, _ = residual_profiles(SimpleNamespace(x=inside, J=q.J, vol0=q.vol0, n=q.n), s, x_end, a)
+    _, z2, _ = residual_profiles(SimpleNamespace(x=inside, J=q.J, vol0=q.vol0, z0=q.z0, n=q.n), s, x_end, a)
     assert z2[-1] > z0[-1]
+
+
+def _stretched_skin_block(scene: Scene, stretch: float):
+    """A groove's cross-section repeated along x: the surface layer (z0 = -h/2) lowered 10 um and stretched
+    sideways by ``stretch`` (particle centres ``stretch`` h apart in y), on the unstretched layer below it
+    (z0 = -3h/2, one h deeper): the residual profile of journal 2026-12-03-groove-below-sphere."""
+    h = scene.discretisation.particle_size_m
+    xs = (np.arange(int(scene.domain.length_m / h)) + 0.5) * h
+    n_y = int(scene.domain.radius_m / h)
+    skin_y = (np.arange(int(n_y / stretch)) + 0.5) * stretch * h
+    below_y = (np.arange(n_y) + 0.5) * h
+    rows = []
+    for ys, zc, z0 in ((skin_y, -10e-6 - 0.5 * h, -0.5 * h), (below_y, -10e-6 - 1.5 * h, -1.5 * h)):
+        X, Y = np.meshgrid(xs, ys, indexing="ij")
+        rows.append(np.stack([X.ravel(), Y.ravel(), np.full(X.size, zc), np.full(X.size, z0)], axis=1))
+    a = np.vstack(rows)
+    n = a.shape[0]
+    return SimpleNamespace(x=a[:, :3].copy(), J=np.ones(n), vol0=np.full(n, h**3), z0=a[:, 3].copy(), n=n)
+
+
+@pytest.mark.parametrize("stretch", [1.1, 1.19, 1.5, 1.9])
+def test_the_profile_bridges_gaps_in_a_stretched_surface_layer(scene, stretch, monkeypatch):
+    """A surface layer stretched sideways opens bins without a particle of it; the profile keeps to the layer
+    (10 um deep everywhere) instead of falling one particle size to the layer below in those bins."""
+    h = scene.discretisation.particle_size_m
+    p = _stretched_skin_block(scene, stretch)
+    a, x_end = 50e-6, scene.start_x_m + scene.sliding.distance_m
+    y, z, _ = residual_profiles(p, scene, x_end, a)
+    covered = y < (int(int(scene.domain.radius_m / h) / stretch) - 0.5) * stretch * h  # inside the layer's span
+    np.testing.assert_allclose(z[covered], -10e-6, rtol=1e-12)
+    assert io.groove_depths(y[covered], z[covered], a)[0] == pytest.approx(10e-6)
+    # the scene does have gaps: without bridging those bins drop to the layer below
+    monkeypatch.setattr(io, "SKIN_BRIDGE_SPAN_H", 0.0)
+    _, z_raw, _ = residual_profiles(p, scene, x_end, a)
+    assert np.nanmin(z_raw[covered]) == pytest.approx(-10e-6 - h)
+
+
+def test_a_layer_torn_wider_than_a_particle_is_not_bridged(scene):
+    """Surface-layer particles 2.5 h apart leave a gap wider than a particle: the material below shows."""
+    h = scene.discretisation.particle_size_m
+    y, z, _ = residual_profiles(_stretched_skin_block(scene, 2.5), scene,
+                                scene.start_x_m + scene.sliding.distance_m, 50e-6)
+    assert np.nanmin(z) == pytest.approx(-10e-6 - h)
+
+
+def test_bridging_leaves_bins_holding_the_surface_layer_alone():
+    """A V-shaped valley sampled by its own surface layer (one particle per bin, off the bins' centres): no bin
+    changes, so the valley's bottom stays its particle's top; an empty bin takes the line between its
+    neighbours; neighbours 2 h apart or more bridge nothing."""
+    h = 1e-5
+    centres = (np.arange(6) + 0.5) * h
+    skin_y = centres + np.array([0.3, -0.3, 0.4, -0.2, 0.1, 0.0]) * h
+    skin_top = -np.abs(skin_y - 2.5 * h) * 0.5  # slope 0.5, lowest near bin 2
+    z = np.full(6, -np.inf)
+    np.maximum.at(z, np.arange(6), skin_top)
+    before = z.copy()
+    io.bridge_skin_gaps(z, centres, skin_y, skin_top, h)
+    np.testing.assert_array_equal(z, before)
+    # drop bin 3's particle and put a deep one there: bin 3 takes the line between bins 2 and 4 (1.7 h apart)
+    keep = np.arange(6) != 3
+    z = before.copy()
+    z[3] = -5 * h
+    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_top[keep], h)
+    w = (centres[3] - skin_y[2]) / (skin_y[4] - skin_y[2])
+    assert z[3] == pytest.approx(skin_top[2] + w * (skin_top[4] - skin_top[2]))
+    np.testing.assert_array_equal(z[keep], before[keep])
+    # bins 2, 3 and 4 emptied: neighbours 1 and 5 are 3.5 h apart, nothing bridged
+    keep = ~np.isin(np.arange(6), [2, 3, 4])
+    z = np.where(keep, before, -5 * h)
+    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_top[keep], h)
+    np.testing.assert_array_equal(z[~keep], -5 * h)
+
+
+def test_the_surface_layer_is_the_top_row_at_every_particle_size(scene):
+    """started_at_surface: the lattice's top row (z0 = -h/2) and the graded far field's (2 h particles at
+    z0 = -h), nothing below."""
+    h = 1e-5
+    p = SimpleNamespace(z0=np.array([-0.5 * h, -1.5 * h, -h, -3 * h]),
+                        vol0=np.array([h**3, h**3, 8 * h**3, 8 * h**3]))
+    assert list(io.started_at_surface(p)) == [True, False, True, False]
 
 
 def test_coarse_particles_are_sampled_on_the_fine_columns():

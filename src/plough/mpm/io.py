@@ -241,6 +241,52 @@ def surface_samples(p: Particles, h: float) -> tuple[np.ndarray, np.ndarray, np.
     return (np.concatenate([p.x[fi, 0], sx]), np.concatenate([p.x[fi, 1], sy]), top[index], index)
 
 
+#: the widest gap between two neighbouring particles of the surface layer that the residual profile bridges,
+#: centre to centre in particle sizes h: below 2 h the gap between their faces is narrower than one particle
+#: (a layer stretched sideways by less than 2x, each particle wider than h), so the material is continuous
+#: there and the particle seen through the gap belongs to the layer below
+SKIN_BRIDGE_SPAN_H = 2.0
+
+
+def started_at_surface(p: Particles) -> np.ndarray:
+    """Particles whose top face started at the block's top surface z = 0 (the surface layer, every particle
+    size): the material the free surface is made of, since particles carry their material."""
+    edge = np.cbrt(p.vol0)
+    return np.abs(p.z0 + 0.5 * edge) < 0.25 * edge
+
+
+def bridge_skin_gaps(z: np.ndarray, centres: np.ndarray, skin_y: np.ndarray, skin_top: np.ndarray,
+                     h: float) -> None:
+    """Raise, in place, the bins of one section's profile ``z`` that hold no surface-layer particle to the
+    surface layer's line between its two neighbouring particles, where those lie less than
+    ``SKIN_BRIDGE_SPAN_H`` h apart in y (and only if the line is higher than the bin's own highest particle).
+
+    Why: a groove's surface is longer than the flat surface it came from, so its top particle layer is
+    stretched sideways (on Fig. 14's scene at h = 10 um by a fifth); about every fifth bin then holds no
+    particle of that layer, and the highest particle there is one of the layer below, a particle size
+    deeper (journal 2026-12-03-groove-below-sphere). ``skin_y``, ``skin_top``: y and top face of the
+    section's surface-layer samples. A bin holding a surface-layer particle is never changed, so the
+    deepest point of a groove (a valley wider than a particle) stays that particle's own top. (The
+    mirror plane y = 0 needs no image of the layer: a first particle more than h from it would span 2 h
+    with its image, too wide to bridge.)
+    """
+    if skin_y.size < 2:
+        return
+    order = np.argsort(skin_y, kind="stable")
+    ys, tops = skin_y[order], skin_top[order]
+    edges = np.append(centres - 0.5 * h, centres[-1] + 0.5 * h)
+    held = np.zeros(centres.size, dtype=bool)
+    held[np.clip(np.digitize(ys, edges) - 1, 0, centres.size - 1)] = True
+    k = np.searchsorted(ys, centres)  # centres[i] lies between ys[k - 1] and ys[k]
+    ok = (k > 0) & (k < ys.size) & ~held
+    k = np.clip(k, 1, ys.size - 1)
+    span = ys[k] - ys[k - 1]
+    ok &= span < SKIN_BRIDGE_SPAN_H * h
+    w = np.divide(centres - ys[k - 1], span, out=np.zeros(centres.size), where=span > 0)
+    line = tops[k - 1] + w * (tops[k] - tops[k - 1])
+    np.maximum(z, np.where(ok, line, -np.inf), out=z)
+
+
 def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float,
                       distance_m: float | None = None) -> tuple:
     """Surface height z(y) at sections behind the sphere, averaged; (y, z_top, sections x)."""
@@ -281,14 +327,16 @@ def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_ra
     sections = np.linspace(x_lo, x_hi, n_sections) if n_sections > 1 else np.array([0.5 * (x_lo + x_hi)])
     edges = _y_edges(scene)
     centres = 0.5 * (edges[1:] + edges[:-1])
-    sx, sy, top, _ = surface_samples(p, h)
+    sx, sy, top, index = surface_samples(p, h)
     inside = within_block_width(sy, scene)
+    skin = started_at_surface(p)[index]
     profiles = []
     for xs in sections:
         band = (np.abs(sx - xs) < 0.5 * h) & inside
         idx = np.clip(np.digitize(sy[band], edges) - 1, 0, centres.size - 1)
         z = np.full(centres.size, -np.inf)
         np.maximum.at(z, idx, top[band])
+        bridge_skin_gaps(z, centres, sy[band & skin], top[band & skin], h)
         profiles.append(z)
     prof = np.array(profiles)
     prof[~np.isfinite(prof)] = np.nan
