@@ -117,6 +117,26 @@ def test_the_profile_bridges_gaps_in_a_stretched_surface_layer(scene, stretch, m
     assert np.nanmin(z_raw[covered]) == pytest.approx(-10e-6 - h)
 
 
+def test_a_particle_missing_from_one_section_is_bridged_from_the_neighbouring_rows(scene, monkeypatch):
+    """The surface layer unstretched but one particle of it gone from one row (moved along x, as the sliding
+    shears the layer): its neighbours in the same row are 2 h apart, too far to bridge, but the rows beside it
+    along x still hold that column, so the section keeps to the layer (10 um deep) there too."""
+    h = scene.discretisation.particle_size_m
+    p = _stretched_skin_block(scene, 1.0)
+    a, x_end = 50e-6, scene.start_x_m + scene.sliding.distance_m
+    s = replace(scene, outputs=replace(scene.outputs, profile_sections=0))
+    _, _, sections = residual_profiles(p, s, x_end, a)
+    xs = sections[sections.size // 2]
+    gone = (np.abs(p.x[:, 0] - xs) < 0.5 * h) & (np.abs(p.x[:, 1] - 3.5 * h) < 0.1 * h) & (p.z0 > -h)
+    assert gone.sum() == 1
+    q = SimpleNamespace(x=p.x[~gone], J=p.J[~gone], vol0=p.vol0[~gone], z0=p.z0[~gone], n=p.n - 1)
+    y, z, _ = residual_profiles(q, s, x_end, a)
+    np.testing.assert_allclose(z[y < 20 * h], -10e-6, rtol=1e-12)
+    monkeypatch.setattr(io, "SKIN_BRIDGE_REACH_H", 0.5)  # the section's own band only: the bin dips
+    _, z_band, _ = residual_profiles(q, s, x_end, a)
+    assert z_band[3] == pytest.approx(-10e-6 - h / sections.size)
+
+
 def test_a_layer_torn_wider_than_a_particle_is_not_bridged(scene):
     """Surface-layer particles 2.5 h apart leave a gap wider than a particle: the material below shows."""
     h = scene.discretisation.particle_size_m
@@ -136,20 +156,20 @@ def test_bridging_leaves_bins_holding_the_surface_layer_alone():
     z = np.full(6, -np.inf)
     np.maximum.at(z, np.arange(6), skin_top)
     before = z.copy()
-    io.bridge_skin_gaps(z, centres, skin_y, skin_top, h)
+    io.bridge_skin_gaps(z, centres, skin_y, skin_y, skin_top, h)
     np.testing.assert_array_equal(z, before)
     # drop bin 3's particle and put a deep one there: bin 3 takes the line between bins 2 and 4 (1.7 h apart)
     keep = np.arange(6) != 3
     z = before.copy()
     z[3] = -5 * h
-    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_top[keep], h)
+    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_y[keep], skin_top[keep], h)
     w = (centres[3] - skin_y[2]) / (skin_y[4] - skin_y[2])
     assert z[3] == pytest.approx(skin_top[2] + w * (skin_top[4] - skin_top[2]))
     np.testing.assert_array_equal(z[keep], before[keep])
     # bins 2, 3 and 4 emptied: neighbours 1 and 5 are 3.5 h apart, nothing bridged
     keep = ~np.isin(np.arange(6), [2, 3, 4])
     z = np.where(keep, before, -5 * h)
-    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_top[keep], h)
+    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_y[keep], skin_top[keep], h)
     np.testing.assert_array_equal(z[~keep], -5 * h)
 
 

@@ -246,6 +246,10 @@ def surface_samples(p: Particles, h: float) -> tuple[np.ndarray, np.ndarray, np.
 #: (a layer stretched sideways by less than 2x, each particle wider than h), so the material is continuous
 #: there and the particle seen through the gap belongs to the layer below
 SKIN_BRIDGE_SPAN_H = 2.0
+#: how far along x, in h, the surface layer's particles that draw a section's bridging line may lie from the
+#: section (its own band is h / 2): the layer is stretched and sheared along x too, so a one-h band can miss
+#: a column's particle that its neighbour band holds
+SKIN_BRIDGE_REACH_H = 1.5
 
 
 def started_at_surface(p: Particles) -> np.ndarray:
@@ -255,28 +259,30 @@ def started_at_surface(p: Particles) -> np.ndarray:
     return np.abs(p.z0 + 0.5 * edge) < 0.25 * edge
 
 
-def bridge_skin_gaps(z: np.ndarray, centres: np.ndarray, skin_y: np.ndarray, skin_top: np.ndarray,
-                     h: float) -> None:
+def bridge_skin_gaps(z: np.ndarray, centres: np.ndarray, held_y: np.ndarray, line_y: np.ndarray,
+                     line_top: np.ndarray, h: float) -> None:
     """Raise, in place, the bins of one section's profile ``z`` that hold no surface-layer particle to the
-    surface layer's line between its two neighbouring particles, where those lie less than
-    ``SKIN_BRIDGE_SPAN_H`` h apart in y (and only if the line is higher than the bin's own highest particle).
+    surface layer's line between the two of its particles around the bin's centre, where those lie less
+    than ``SKIN_BRIDGE_SPAN_H`` h apart in y (and only if the line is higher than the bin's own highest
+    particle).
 
     Why: a groove's surface is longer than the flat surface it came from, so its top particle layer is
     stretched sideways (on Fig. 14's scene at h = 10 um by a fifth); about every fifth bin then holds no
     particle of that layer, and the highest particle there is one of the layer below, a particle size
-    deeper (journal 2026-12-03-groove-below-sphere). ``skin_y``, ``skin_top``: y and top face of the
-    section's surface-layer samples. A bin holding a surface-layer particle is never changed, so the
-    deepest point of a groove (a valley wider than a particle) stays that particle's own top. (The
-    mirror plane y = 0 needs no image of the layer: a first particle more than h from it would span 2 h
-    with its image, too wide to bridge.)
+    deeper (journal 2026-12-03-groove-below-sphere). ``held_y``: y of the surface-layer samples in the
+    section's own band (their bins are never changed, so the deepest point of a groove, a valley wider
+    than a particle, stays that particle's own top); ``line_y``, ``line_top``: y and top face of the
+    surface-layer samples within ``SKIN_BRIDGE_REACH_H`` h of the section along x, which draw the line.
+    (The mirror plane y = 0 needs no image of the layer: a first particle more than h from it would span
+    2 h with its image, too wide to bridge.)
     """
-    if skin_y.size < 2:
+    if line_y.size < 2:
         return
-    order = np.argsort(skin_y, kind="stable")
-    ys, tops = skin_y[order], skin_top[order]
+    order = np.argsort(line_y, kind="stable")
+    ys, tops = line_y[order], line_top[order]
     edges = np.append(centres - 0.5 * h, centres[-1] + 0.5 * h)
     held = np.zeros(centres.size, dtype=bool)
-    held[np.clip(np.digitize(ys, edges) - 1, 0, centres.size - 1)] = True
+    held[np.clip(np.digitize(held_y, edges) - 1, 0, centres.size - 1)] = True
     k = np.searchsorted(ys, centres)  # centres[i] lies between ys[k - 1] and ys[k]
     ok = (k > 0) & (k < ys.size) & ~held
     k = np.clip(k, 1, ys.size - 1)
@@ -332,11 +338,13 @@ def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_ra
     skin = started_at_surface(p)[index]
     profiles = []
     for xs in sections:
-        band = (np.abs(sx - xs) < 0.5 * h) & inside
+        dx = np.abs(sx - xs)
+        band = (dx < 0.5 * h) & inside
         idx = np.clip(np.digitize(sy[band], edges) - 1, 0, centres.size - 1)
         z = np.full(centres.size, -np.inf)
         np.maximum.at(z, idx, top[band])
-        bridge_skin_gaps(z, centres, sy[band & skin], top[band & skin], h)
+        reach = (dx < SKIN_BRIDGE_REACH_H * h) & inside & skin
+        bridge_skin_gaps(z, centres, sy[band & skin], sy[reach], top[reach], h)
         profiles.append(z)
     prof = np.array(profiles)
     prof[~np.isfinite(prof)] = np.nan
