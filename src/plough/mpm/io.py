@@ -514,7 +514,11 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
                 "section_x": (("section",), sections, {"units": "m", "long_name": "x of the residual cross-sections"})},
     )
     ds["profile_z"] = (("y",), z_top, {"units": "m", "long_name": "residual surface height, mean of the sections",
-                                       "allow_missing": 1})
+                                       "allow_missing": 1,
+                                       "surface_layer_gaps": f"bridged where the layer's particles lie under "
+                                                             f"{SKIN_BRIDGE_SPAN_H:g} h apart in y, drawn from "
+                                                             f"within {SKIN_BRIDGE_REACH_H:g} h along x "
+                                                             "(docs/model.md, the residual groove)"})
     pic_vars, pic_extra = picture_variables(p, scene, sphere_centre, coating_row, a_exp, sections)
     ds = ds.assign_coords(pic_extra["coords"])
     for name, var in pic_vars.items():
