@@ -117,38 +117,50 @@ def test_the_profile_bridges_gaps_in_a_stretched_surface_layer(scene, stretch, m
     assert np.nanmin(z_raw[covered]) == pytest.approx(-10e-6 - h)
 
 
-def test_a_particle_missing_from_one_section_is_bridged_from_the_neighbouring_rows(scene, monkeypatch):
+@pytest.mark.parametrize("column", [3, 0])  # an inner column, and the one next to the mirror plane
+def test_a_particle_missing_from_one_section_is_bridged_from_the_neighbouring_rows(scene, monkeypatch, column):
     """The surface layer unstretched but one particle of it gone from one row (moved along x, as the sliding
     shears the layer): its neighbours in the same row are 2 h apart, too far to bridge, but the rows beside it
-    along x still hold that column, so the section keeps to the layer (10 um deep) there too."""
+    along x still hold that column, so the section keeps to the layer (10 um deep) there too; next to the
+    mirror plane the layer's image across it closes the line."""
     h = scene.discretisation.particle_size_m
     p = _stretched_skin_block(scene, 1.0)
     a, x_end = 50e-6, scene.start_x_m + scene.sliding.distance_m
     s = replace(scene, outputs=replace(scene.outputs, profile_sections=0))
+    assert s.domain.symmetric
     _, _, sections = residual_profiles(p, s, x_end, a)
     xs = sections[sections.size // 2]
-    gone = (np.abs(p.x[:, 0] - xs) < 0.5 * h) & (np.abs(p.x[:, 1] - 3.5 * h) < 0.1 * h) & (p.z0 > -h)
+    gone = (np.abs(p.x[:, 0] - xs) < 0.5 * h) & (np.abs(p.x[:, 1] - (column + 0.5) * h) < 0.1 * h) & (p.z0 > -h)
     assert gone.sum() == 1
     q = SimpleNamespace(x=p.x[~gone], J=p.J[~gone], vol0=p.vol0[~gone], z0=p.z0[~gone], n=p.n - 1)
     y, z, _ = residual_profiles(q, s, x_end, a)
     np.testing.assert_allclose(z[y < 20 * h], -10e-6, rtol=1e-12)
     monkeypatch.setattr(io, "SKIN_BRIDGE_REACH_H", 0.5)  # the section's own band only: the bin dips
     _, z_band, _ = residual_profiles(q, s, x_end, a)
-    assert z_band[3] == pytest.approx(-10e-6 - h / sections.size)
+    assert z_band[column] == pytest.approx(-10e-6 - h / sections.size)
 
 
-def test_a_layer_torn_wider_than_a_particle_is_not_bridged(scene):
-    """Surface-layer particles 2.5 h apart leave a gap wider than a particle: the material below shows."""
+def test_a_layer_torn_wider_than_a_particle_is_not_bridged(scene, monkeypatch):
+    """Surface-layer particles 2.5 h apart leave gaps wider than a particle: the material below shows in the
+    bins between them (and a looser limit would have bridged them)."""
     h = scene.discretisation.particle_size_m
-    y, z, _ = residual_profiles(_stretched_skin_block(scene, 2.5), scene,
-                                scene.start_x_m + scene.sliding.distance_m, 50e-6)
-    assert np.nanmin(z) == pytest.approx(-10e-6 - h)
+    p = _stretched_skin_block(scene, 2.5)
+    a, x_end = 50e-6, scene.start_x_m + scene.sliding.distance_m
+    y, z, _ = residual_profiles(p, scene, x_end, a)
+    layer_y = (np.arange(20) + 0.5) * 2.5 * h
+    bins_without = [b for b in range(1, 12) if not np.any(np.abs(layer_y - (b + 0.5) * h) < 0.5 * h)]
+    assert len(bins_without) >= 5
+    np.testing.assert_allclose(z[bins_without], -10e-6 - h, rtol=1e-12)
+    monkeypatch.setattr(io, "SKIN_BRIDGE_SPAN_H", 3.0)
+    _, z_loose, _ = residual_profiles(p, scene, x_end, a)
+    np.testing.assert_allclose(z_loose[bins_without], -10e-6, rtol=1e-12)
 
 
 def test_bridging_leaves_bins_holding_the_surface_layer_alone():
     """A V-shaped valley sampled by its own surface layer (one particle per bin, off the bins' centres): no bin
     changes, so the valley's bottom stays its particle's top; an empty bin takes the line between its
-    neighbours; neighbours 2 h apart or more bridge nothing."""
+    neighbours; neighbours 2 h apart or more bridge nothing; a second set of samples bridges what the first
+    could not."""
     h = 1e-5
     centres = (np.arange(6) + 0.5) * h
     skin_y = centres + np.array([0.3, -0.3, 0.4, -0.2, 0.1, 0.0]) * h
@@ -156,21 +168,28 @@ def test_bridging_leaves_bins_holding_the_surface_layer_alone():
     z = np.full(6, -np.inf)
     np.maximum.at(z, np.arange(6), skin_top)
     before = z.copy()
-    io.bridge_skin_gaps(z, centres, skin_y, skin_y, skin_top, h)
+    io.bridge_skin_gaps(z, centres, np.ones(6, dtype=bool), [(skin_y, skin_top)], h)
     np.testing.assert_array_equal(z, before)
     # drop bin 3's particle and put a deep one there: bin 3 takes the line between bins 2 and 4 (1.7 h apart)
     keep = np.arange(6) != 3
     z = before.copy()
     z[3] = -5 * h
-    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_y[keep], skin_top[keep], h)
+    io.bridge_skin_gaps(z, centres, keep, [(skin_y[keep], skin_top[keep])], h)
     w = (centres[3] - skin_y[2]) / (skin_y[4] - skin_y[2])
     assert z[3] == pytest.approx(skin_top[2] + w * (skin_top[4] - skin_top[2]))
     np.testing.assert_array_equal(z[keep], before[keep])
-    # bins 2, 3 and 4 emptied: neighbours 1 and 5 are 3.5 h apart, nothing bridged
+    # bins 2, 3 and 4 emptied: neighbours 1 and 5 are 3.5 h apart, nothing bridged by that set ...
     keep = ~np.isin(np.arange(6), [2, 3, 4])
     z = np.where(keep, before, -5 * h)
-    io.bridge_skin_gaps(z, centres, skin_y[keep], skin_y[keep], skin_top[keep], h)
+    io.bridge_skin_gaps(z, centres, keep, [(skin_y[keep], skin_top[keep])], h)
     np.testing.assert_array_equal(z[~keep], -5 * h)
+    # ... but a second set that also holds bin 2's particle (from a neighbouring row) bridges bin 2 (1.2 h to
+    # 2.9 h: 1.7 h), not bins 3 and 4 (2.9 h to 5.5 h: 2.6 h)
+    second = (np.append(skin_y[keep], skin_y[2]), np.append(skin_top[keep], skin_top[2]))
+    io.bridge_skin_gaps(z, centres, keep, [(skin_y[keep], skin_top[keep]), second], h)
+    w = (centres[2] - skin_y[1]) / (skin_y[2] - skin_y[1])
+    assert z[2] == pytest.approx(skin_top[1] + w * (skin_top[2] - skin_top[1]))
+    assert z[3] == -5 * h and z[4] == -5 * h
 
 
 def test_the_surface_layer_is_the_top_row_at_every_particle_size(scene):

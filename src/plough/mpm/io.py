@@ -246,9 +246,9 @@ def surface_samples(p: Particles, h: float) -> tuple[np.ndarray, np.ndarray, np.
 #: (a layer stretched sideways by less than 2x, each particle wider than h), so the material is continuous
 #: there and the particle seen through the gap belongs to the layer below
 SKIN_BRIDGE_SPAN_H = 2.0
-#: how far along x, in h, the surface layer's particles that draw a section's bridging line may lie from the
-#: section (its own band is h / 2): the layer is stretched and sheared along x too, so a one-h band can miss
-#: a column's particle that its neighbour band holds
+#: where a section's own band (h wide) leaves a gap too wide to bridge, the layer's particles within this many
+#: h of the section along x draw the line instead: the sliding shears and shifts the layer along x too, so a
+#: one-h band can miss a column's particle that its neighbouring band holds
 SKIN_BRIDGE_REACH_H = 1.5
 
 
@@ -259,38 +259,45 @@ def started_at_surface(p: Particles) -> np.ndarray:
     return np.abs(p.z0 + 0.5 * edge) < 0.25 * edge
 
 
-def bridge_skin_gaps(z: np.ndarray, centres: np.ndarray, held_y: np.ndarray, line_y: np.ndarray,
-                     line_top: np.ndarray, h: float) -> None:
-    """Raise, in place, the bins of one section's profile ``z`` that hold no surface-layer particle to the
-    surface layer's line between the two of its particles around the bin's centre, where those lie less
-    than ``SKIN_BRIDGE_SPAN_H`` h apart in y (and only if the line is higher than the bin's own highest
-    particle).
-
-    Why: a groove's surface is longer than the flat surface it came from, so its top particle layer is
-    stretched sideways (on Fig. 14's scene at h = 10 um by a fifth); about every fifth bin then holds no
-    particle of that layer, and the highest particle there is one of the layer below, a particle size
-    deeper (journal 2026-12-03-groove-below-sphere). ``held_y``: y of the surface-layer samples in the
-    section's own band (their bins are never changed, so the deepest point of a groove, a valley wider
-    than a particle, stays that particle's own top); ``line_y``, ``line_top``: y and top face of the
-    surface-layer samples within ``SKIN_BRIDGE_REACH_H`` h of the section along x, which draw the line.
-    (The mirror plane y = 0 needs no image of the layer: a first particle more than h from it would span
-    2 h with its image, too wide to bridge.)
-    """
-    if line_y.size < 2:
-        return
-    order = np.argsort(line_y, kind="stable")
-    ys, tops = line_y[order], line_top[order]
-    edges = np.append(centres - 0.5 * h, centres[-1] + 0.5 * h)
-    held = np.zeros(centres.size, dtype=bool)
-    held[np.clip(np.digitize(held_y, edges) - 1, 0, centres.size - 1)] = True
+def layer_line(centres: np.ndarray, y: np.ndarray, top: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray]:
+    """(height, ok) at each of ``centres``: the straight line between the two samples (y, top) around it,
+    ok where they lie less than ``SKIN_BRIDGE_SPAN_H`` h apart (and a sample lies on either side)."""
+    if y.size < 2:
+        return np.full(centres.size, -np.inf), np.zeros(centres.size, dtype=bool)
+    order = np.argsort(y, kind="stable")
+    ys, tops = y[order], top[order]
     k = np.searchsorted(ys, centres)  # centres[i] lies between ys[k - 1] and ys[k]
-    ok = (k > 0) & (k < ys.size) & ~held
+    ok = (k > 0) & (k < ys.size)
     k = np.clip(k, 1, ys.size - 1)
     span = ys[k] - ys[k - 1]
     ok &= span < SKIN_BRIDGE_SPAN_H * h
     w = np.divide(centres - ys[k - 1], span, out=np.zeros(centres.size), where=span > 0)
-    line = tops[k - 1] + w * (tops[k] - tops[k - 1])
-    np.maximum(z, np.where(ok, line, -np.inf), out=z)
+    return tops[k - 1] + w * (tops[k] - tops[k - 1]), ok
+
+
+def bridge_skin_gaps(z: np.ndarray, centres: np.ndarray, held: np.ndarray,
+                     layers: list[tuple[np.ndarray, np.ndarray]], h: float) -> None:
+    """Raise, in place, the bins of one section's profile ``z`` that hold no surface-layer particle
+    (``held`` False) to the surface layer's straight line between its two particles around the bin's centre,
+    where those lie less than ``SKIN_BRIDGE_SPAN_H`` h apart in y, and only if the line is higher than the
+    bin's own highest particle.
+
+    Why: a groove's surface is longer than the flat surface it came from, so its top particle layer is
+    stretched sideways (on Fig. 14's scene at h = 10 um by a fifth); about every fifth bin then holds no
+    particle of that layer, and the highest particle there is one of the layer below, a particle size
+    deeper (journal 2026-12-03-groove-below-sphere). ``layers``: the (y, top face) sets of the layer's
+    samples that may draw the line, tried in turn (the section's own band, then within
+    ``SKIN_BRIDGE_REACH_H`` h of it); a bin takes the first set that spans it narrowly enough. A held bin
+    is never changed, so a valley wider than a particle keeps its own highest particle at the bottom.
+    """
+    todo = ~held
+    for y, top in layers:
+        if not todo.any():
+            return
+        line, ok = layer_line(centres, y, top, h)
+        use = todo & ok
+        z[use] = np.maximum(z[use], line[use])
+        todo &= ~ok
 
 
 def residual_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_radius: float,
@@ -311,7 +318,9 @@ def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_ra
                      distance_m: float | None = None) -> tuple:
     """Surface height z(y) at each section behind the sphere; (y, z_top per section, sections x).
 
-    z_top has one row per section (NaN in a bin no particle column reaches)."""
+    z_top has one row per section: in each bin the highest particle top face of the section's band, or the
+    surface layer's line across a gap narrower than a particle (:func:`bridge_skin_gaps`); NaN where
+    neither reaches."""
     h = scene.discretisation.particle_size_m
     x0 = scene.start_x_m
     d = scene.sliding.distance_m if distance_m is None else distance_m
@@ -343,8 +352,12 @@ def section_profiles(p: Particles, scene: Scene, sphere_x_end: float, contact_ra
         idx = np.clip(np.digitize(sy[band], edges) - 1, 0, centres.size - 1)
         z = np.full(centres.size, -np.inf)
         np.maximum.at(z, idx, top[band])
-        reach = (dx < SKIN_BRIDGE_REACH_H * h) & inside & skin
-        bridge_skin_gaps(z, centres, sy[band & skin], sy[reach], top[reach], h)
+        held = np.zeros(centres.size, dtype=bool)
+        held[idx[skin[band]]] = True
+        layers = [(sy[m], top[m]) for m in (band & skin, (dx < SKIN_BRIDGE_REACH_H * h) & inside & skin)]
+        if scene.domain.symmetric:  # the layer goes on across the mirror plane as its own image
+            layers = [(np.concatenate([-y, y]), np.concatenate([t, t])) for y, t in layers]
+        bridge_skin_gaps(z, centres, held, layers, h)
         profiles.append(z)
     prof = np.array(profiles)
     prof[~np.isfinite(prof)] = np.nan
