@@ -36,6 +36,13 @@ def fig14_scene(h_um: float):
     return matrix.scene_for(point, h_um, config["mpm"]["numerics"])
 
 
+def fig18_scene(thickness_um: float, h_um: float):
+    """One of Fig. 18's scenes (22 N, 1 mm ball) as the workflow builds it; thickness 0 is the zinc block."""
+    config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    points = {round(p.thickness_m * 1e6): p for p in matrix.all_points(config, ("fig18",)).values()}
+    return matrix.scene_for(points[round(thickness_um)], h_um, config["mpm"]["numerics"])
+
+
 def run_quietly(scene, threads: int = 2):
     """The run's dataset, without the progress bar or the solver's warnings."""
     with warnings.catch_warnings():

@@ -16,12 +16,9 @@ import importlib.util
 from pathlib import Path
 
 import numpy as np
-import yaml
 
 from plough.mpm import io as pio
-from plough.study import matrix
 
-ROOT = Path(__file__).resolve().parents[3]
 _spec = importlib.util.spec_from_file_location("probe", Path(__file__).with_name("probe.py"))
 probe = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(probe)
@@ -33,9 +30,7 @@ def main() -> None:
     ap.add_argument("--thickness-um", type=float, required=True)
     ap.add_argument("--y-um", type=float, required=True)
     a = ap.parse_args()
-    config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    points = {round(p.thickness_m * 1e6): p for p in matrix.all_points(config, ("fig18",)).values()}
-    scene = matrix.scene_for(points[round(a.thickness_um)], a.h_um, config["mpm"]["numerics"])
+    scene = probe.fig18_scene(a.thickness_um, a.h_um)
     kept = {}
     original = pio.section_profiles
 

@@ -15,12 +15,8 @@ import importlib.util
 import json
 from pathlib import Path
 
-import yaml
-
 from plough.io import git_commit
-from plough.study import matrix
 
-ROOT = Path(__file__).resolve().parents[3]
 _spec = importlib.util.spec_from_file_location("probe", Path(__file__).with_name("probe.py"))
 probe = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(probe)
@@ -32,15 +28,12 @@ def main() -> None:
     ap.add_argument("--thickness-um", type=float, nargs="+", required=True)
     ap.add_argument("--out", type=Path, required=True)
     a = ap.parse_args()
-    config = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
-    points = {round(p.thickness_m * 1e6): p for p in matrix.all_points(config, ("fig18",)).values()}
     data = json.loads(a.out.read_text()) if a.out.exists() else {"commit": git_commit(), "runs": []}
     done = {r["thickness_um"] for r in data["runs"]}
     for t in a.thickness_um:
         if t in done:
             continue
-        scene = matrix.scene_for(points[round(t)], a.h_um, config["mpm"]["numerics"])
-        row = {"thickness_um": t, "h_um": a.h_um, **probe.measure(scene)}
+        row = {"thickness_um": t, "h_um": a.h_um, **probe.measure(probe.fig18_scene(t, a.h_um))}
         data["runs"].append(row)
         a.out.write_text(json.dumps(data, indent=1))
         prof = " ".join("nan" if v is None else f"{v * 1e6:.1f}" for v in row["profile_z_m"][:10])
