@@ -12,16 +12,15 @@ bridged and unbridged heights.
 from __future__ import annotations
 
 import argparse
-import importlib.util
+import sys
 from pathlib import Path
 
 import numpy as np
 
 from plough.mpm import io as pio
 
-_spec = importlib.util.spec_from_file_location("probe", Path(__file__).with_name("probe.py"))
-probe = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(probe)
+sys.path.insert(0, str(Path(__file__).parent))  # this entry's probe.py: the scene and the quiet run
+import probe  # noqa: E402
 
 
 def main() -> None:
