@@ -18,6 +18,11 @@ from plough.mpm.scene import Scene
 ROOT = Path(__file__).resolve().parents[2]
 
 
+def _particles(x: np.ndarray, vol0: np.ndarray, z0: np.ndarray, J: np.ndarray | None = None) -> SimpleNamespace:
+    """The particle fields the residual profile reads (n derived from x; J 1 unless given)."""
+    return SimpleNamespace(x=x, J=np.ones(x.shape[0]) if J is None else J, vol0=vol0, z0=z0, n=x.shape[0])
+
+
 def _grooved_block(scene: Scene, depth_of_row):
     """Top particle layer of a block whose top face sits at -depth_of_row(row) across |y| < 30 um."""
     h = scene.discretisation.particle_size_m
@@ -28,7 +33,7 @@ def _grooved_block(scene: Scene, depth_of_row):
     top = np.where(Y < 30e-6, -depth_of_row(rows), 0.0)
     x = np.stack([X.ravel(), Y.ravel(), (top - 0.5 * h).ravel()], axis=1)
     n = x.shape[0]
-    return SimpleNamespace(x=x, J=np.ones(n), vol0=np.full(n, h**3), z0=np.full(n, -0.5 * h), n=n), xs
+    return _particles(x, np.full(n, h**3), np.full(n, -0.5 * h)), xs
 
 
 @pytest.fixture
@@ -72,13 +77,12 @@ def test_material_thrown_past_the_blocks_side_is_not_read_as_its_surface(scene):
     a, x_end = 50e-6, s.start_x_m + s.sliding.distance_m
     y, z0, sections = residual_profiles(p, s, x_end, a)
     thrown = np.array([[sections[1], s.domain.radius_m + 0.6 * s.discretisation.particle_size_m, 13e-6]])
-    q = SimpleNamespace(x=np.vstack([p.x, thrown]), J=np.ones(p.n + 1), vol0=np.append(p.vol0, p.vol0[0]),
-                        z0=np.append(p.z0, p.z0[0]), n=p.n + 1)
+    q = _particles(np.vstack([p.x, thrown]), np.append(p.vol0, p.vol0[0]), np.append(p.z0, p.z0[0]))
     _, z1, _ = residual_profiles(q, s, x_end, a)
     np.testing.assert_array_equal(z1, z0)
     inside = q.x.copy()
     inside[-1, 1] = s.domain.radius_m - 3e-6  # the same particle inside the block's width does count
-    _, z2, _ = residual_profiles(SimpleNamespace(x=inside, J=q.J, vol0=q.vol0, z0=q.z0, n=q.n), s, x_end, a)
+    _, z2, _ = residual_profiles(_particles(inside, q.vol0, q.z0), s, x_end, a)
     assert z2[-1] > z0[-1]
 
 
@@ -96,8 +100,7 @@ def _stretched_skin_block(scene: Scene, stretch: float):
         X, Y = np.meshgrid(xs, ys, indexing="ij")
         rows.append(np.stack([X.ravel(), Y.ravel(), np.full(X.size, zc), np.full(X.size, z0)], axis=1))
     a = np.vstack(rows)
-    n = a.shape[0]
-    return SimpleNamespace(x=a[:, :3].copy(), J=np.ones(n), vol0=np.full(n, h**3), z0=a[:, 3].copy(), n=n)
+    return _particles(a[:, :3].copy(), np.full(a.shape[0], h**3), a[:, 3].copy())
 
 
 @pytest.mark.parametrize("stretch", [1.1, 1.19, 1.5, 1.9])
@@ -132,7 +135,7 @@ def test_a_particle_missing_from_one_section_is_bridged_from_the_neighbouring_ro
     xs = sections[sections.size // 2]
     gone = (np.abs(p.x[:, 0] - xs) < 0.5 * h) & (np.abs(p.x[:, 1] - (column + 0.5) * h) < 0.1 * h) & (p.z0 > -h)
     assert gone.sum() == 1
-    q = SimpleNamespace(x=p.x[~gone], J=p.J[~gone], vol0=p.vol0[~gone], z0=p.z0[~gone], n=p.n - 1)
+    q = _particles(p.x[~gone], p.vol0[~gone], p.z0[~gone])
     y, z, _ = residual_profiles(q, s, x_end, a)
     np.testing.assert_allclose(z[y < 20 * h], -10e-6, rtol=1e-12)
     monkeypatch.setattr(io, "SKIN_BRIDGE_REACH_H", 0.5)  # the section's own band only: the bin dips
