@@ -36,7 +36,7 @@ from plough.mpm.run import simulate
 
 ROOT = Path(__file__).resolve().parents[1]
 KEEP = ("mu", "mu_standard_error", "mu_pl", "mu_sh", "dp", "dp_standard_error", "dg", "dg_standard_error", "hpu",
-        "hpu_standard_error", "Fz_mean", "mu_drift", "material_top_rise", "steady")
+        "hpu_standard_error", "penetration", "Fz_mean", "mu_drift", "material_top_rise", "steady")
 GROOVE = ("dp", "dg", "hpu")
 
 

@@ -3,9 +3,9 @@ reference scenes at f = 0.5 (below the wave limit), workflow numerics, h = 20 / 
 to h -> 0 with its uncertainty (GCI-type and the runs' errors carried to the limit, in quadrature) against the
 analytical model.
 
-    python docs/journal/2026-12-02-groove-uncertainty/f05_ladder.py [--sizes-um 20 10 5] [--threads 2]
+    python docs/journal/2026-12-02-groove-uncertainty/f05_ladder.py [--sizes-um 20 10 5] [--threads 2] [--out FILE]
 
-Writes f05_ladder.json beside this file and prints a table.
+Writes f05_ladder.json beside this file (or FILE) and prints a table.
 """
 
 from __future__ import annotations
@@ -30,6 +30,7 @@ from plough.mpm.run import simulate  # noqa: E402
 from plough.study.extrapolation import Method, extrapolate, sampling_error, total_uncertainty  # noqa: E402
 
 OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp")
+MEASURED = ("penetration",)  # recorded beside the outputs, not extrapolated
 
 
 def analytical(scene) -> dict[str, float]:
@@ -44,6 +45,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[20.0, 10.0, 5.0])
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--out", type=Path, default=HERE / "f05_ladder.json")
     args = parser.parse_args()
     out = {"git_commit": git_commit(), "sizes_um": args.sizes_um, "scenes": {}}
     for name in ("coated", "uncoated"):
@@ -56,6 +58,7 @@ def main() -> None:
                 ds = simulate(scene, progress=False, threads=args.threads)
             row = {o: float(ds[o]) for o in OUTPUTS}
             row.update({f"{o}_standard_error": float(ds[f"{o}_standard_error"]) for o in OUTPUTS})
+            row.update({m: float(ds[m]) for m in MEASURED})
             row.update(h_um=h, steady=int(ds["steady"]), wall_s=float(ds.attrs["cost_wall_time_s"]))
             runs.append(row)
             print(f"  {name} f = 0.5, h = {h:g} um: mu {row['mu']:.4f} +- {row['mu_standard_error']:.4f}, "
@@ -74,7 +77,7 @@ def main() -> None:
                          "method": Method(int(ex.method)).name.lower(), "analytical": ana[o],
                          "relative_to_analytical": float(ex.value) / ana[o] - 1.0}
         out["scenes"][name] = {"runs": runs, "limits": limits}
-        (HERE / "f05_ladder.json").write_text(json.dumps(out, indent=1) + "\n")
+        args.out.write_text(json.dumps(out, indent=1) + "\n")
     print("| scene | output | h -> 0 | method | uncertainty (GCI, sampling) | relative | analytical "
           "| MPM / analytical - 1 |")
     print("|---|---|---|---|---|---|---|---|")
