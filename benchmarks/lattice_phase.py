@@ -1,6 +1,7 @@
 """How much one run's mu and dp depend on where the sphere starts against the particle lattice.
 
     python benchmarks/lattice_phase.py [--cases coated:20 coated:10 real:20] [--phases 8] [--threads 2] [--out FILE]
+                                       [--contact grid | grid_local | particle]
 
 The particle lattice and the grid are anchored at x = 0 and the sphere starts at the middle of the
 block minus half the slide. Lengthening the block by 2 phi h moves the start by phi h against the
@@ -40,9 +41,10 @@ KEEP = ("mu", "mu_standard_error", "mu_pl", "mu_sh", "dp", "dp_standard_error", 
 GROOVE = ("dp", "dg", "hpu")
 
 
-def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
+def phase_runs(name: str, h_um: float, phases: int, threads: int, contact: str = "grid") -> dict:
     h = h_um * 1e-6
     base = workflow_scene(name, h)
+    base = replace(base, discretisation=replace(base.discretisation, contact=contact))
     runs = []
     for k in range(phases):
         shift = k / phases * h
@@ -73,7 +75,7 @@ def phase_runs(name: str, h_um: float, phases: int, threads: int) -> dict:
             term = np.array([r["lattice_phase_term_m"] for r in runs])
             jack = np.sqrt(np.maximum(se**2 - term**2, 0.0))
             summary[q]["rms_z_jackknife_only"] = rms_z(v, jack)
-    return {"scene": name, "h_um": h_um, "phases": phases, "runs": runs, "summary": summary}
+    return {"scene": name, "h_um": h_um, "contact": contact, "phases": phases, "runs": runs, "summary": summary}
 
 
 def rms_z(values: np.ndarray, errors: np.ndarray) -> float | None:
@@ -91,12 +93,13 @@ def main() -> None:
     parser.add_argument("--cases", nargs="+", default=["coated:20", "coated:10", "real:20"], help="scene:h_um")
     parser.add_argument("--phases", type=int, default=8)
     parser.add_argument("--threads", type=int, default=2)
+    parser.add_argument("--contact", default="grid", help="discretisation.contact of every run (default: grid)")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "lattice_phase.json")
     args = parser.parse_args()
     cases = []
     for case in args.cases:
         name, h_um = case.split(":")
-        cases.append(phase_runs(name, float(h_um), args.phases, args.threads))
+        cases.append(phase_runs(name, float(h_um), args.phases, args.threads, args.contact))
         args.out.write_text(json.dumps({"git_commit": git_commit(), "threads": args.threads, "cases": cases},
                                        indent=1) + "\n")
     print("| scene | h (um) | mu: mean, spread (std) over phases | median SE | rms z "
