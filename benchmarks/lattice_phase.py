@@ -1,7 +1,7 @@
 """How much one run's mu and dp depend on where the sphere starts against the particle lattice.
 
     python benchmarks/lattice_phase.py [--cases coated:20 coated:10 real:20] [--phases 8] [--threads 2] [--out FILE]
-                                       [--contact grid | grid_local | particle]
+                                       [--contact MODE]   (a discretisation.contact of plough.mpm.scene.CONTACT_MODES)
 
 The particle lattice and the grid are anchored at x = 0 and the sphere starts at the middle of the
 block minus half the slide. Lengthening the block by 2 phi h moves the start by phi h against the
@@ -34,6 +34,7 @@ from common import workflow_scene
 
 from plough.io import git_commit
 from plough.mpm.run import simulate
+from plough.mpm.scene import CONTACT_MODES
 
 ROOT = Path(__file__).resolve().parents[1]
 KEEP = ("mu", "mu_standard_error", "mu_pl", "mu_sh", "dp", "dp_standard_error", "dg", "dg_standard_error", "hpu",
@@ -93,7 +94,8 @@ def main() -> None:
     parser.add_argument("--cases", nargs="+", default=["coated:20", "coated:10", "real:20"], help="scene:h_um")
     parser.add_argument("--phases", type=int, default=8)
     parser.add_argument("--threads", type=int, default=2)
-    parser.add_argument("--contact", default="grid", help="discretisation.contact of every run (default: grid)")
+    parser.add_argument("--contact", default="grid", choices=CONTACT_MODES,
+                        help="discretisation.contact of every run (default: grid)")
     parser.add_argument("--out", type=Path, default=ROOT / "benchmarks" / "results" / "lattice_phase.json")
     args = parser.parse_args()
     cases = []
