@@ -173,7 +173,7 @@ def plough(args) -> list[dict]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("case", choices=["hertz", "tabor", "plough"])
-    parser.add_argument("--contact", nargs="+", default=["grid", "particle"])
+    parser.add_argument("--contact", nargs="+", default=["grid_local", "grid"])
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[10.0])
     parser.add_argument("--depths-um", type=float, nargs="+", default=[2.0, 8.0])
     parser.add_argument("--domains-um", type=float, nargs="+", default=[CHECK_BLOCK_UM],

@@ -16,7 +16,7 @@ import yaml
 
 from plough.analytical import ploughing
 from plough.materials import get_material, representative_hardness
-from plough.mpm.scene import Scene
+from plough.mpm.scene import CONTACT_MODES, Discretisation, Scene
 from plough.study import matrix
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -363,6 +363,23 @@ def test_active_zone_reaches_every_scene_of_the_matrix(config, zone):
     del changed["mpm"]["numerics"]["active_zone_contact_radii"]  # absent: every particle
     for d in matrix.all_runs(changed).values():
         assert Scene.from_dict(d).discretisation.active_zone_contact_radii is None
+
+
+def test_contact_reaches_every_scene_of_the_matrix_and_the_schema_offers_every_mode(config):
+    """numerics.contact goes into each run's discretisation (and so its params: a changed contact reruns every
+    run); absent, the scene's default; the schema's choices are the solver's CONTACT_MODES."""
+    assert config["mpm"]["numerics"]["contact"] == Discretisation.contact  # the configs state the default
+    before = matrix.all_runs(config)
+    changed = copy.deepcopy(config)
+    changed["mpm"]["numerics"]["contact"] = "grid"
+    for rid, d in matrix.all_runs(changed).items():
+        assert Scene.from_dict(d).discretisation.contact == "grid" and d != before[rid]
+    del changed["mpm"]["numerics"]["contact"]
+    assert matrix.all_runs(changed) == before
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    numerics = schema["properties"]["mpm"]["properties"]["numerics"]["properties"]
+    assert sorted(numerics["contact"]["enum"]) == sorted(CONTACT_MODES)
+    assert numerics["contact"]["default"] == Discretisation.contact
 
 
 @pytest.mark.parametrize("mode", ["sized", "fixed"])

@@ -32,7 +32,7 @@ import numpy as np
 
 from plough.materials import rigid_plastic
 from plough.mpm import contact, solver
-from plough.mpm.scene import Scene
+from plough.mpm.scene import Discretisation, Scene
 
 R_M, E_PA, NU = 200e-6, 210e9, 0.3
 #: the rigid-plastic hardness of the Tabor scene, Pa (the uncoated reference scene's)
@@ -78,7 +78,8 @@ def _indentation_scene(name: str, substrate, h_um: float, depth_um: float, domai
 
 
 def hertz_scene(h_um: float, depth_um: float, domain_um: float = 240.0, poisson_ratio: float = NU,
-                dilatation: str = "projected", contact_mode: str = "grid", particles_per_cell: int = 2) -> Scene:
+                dilatation: str = "projected", contact_mode: str = Discretisation.contact,
+                particles_per_cell: int = 2) -> Scene:
     """The sphere (R = 200 um) held ``depth_um`` deep in an elastic block that never yields (half block of radius
     ``domain_um``, twice as long, mirror plane; frictionless)."""
     substrate = replace(rigid_plastic("elastic", 1e15, coating=False), poisson_ratio=poisson_ratio)  # never yields
@@ -86,7 +87,7 @@ def hertz_scene(h_um: float, depth_um: float, domain_um: float = 240.0, poisson_
                               particles_per_cell)
 
 
-def tabor_scene(h_um: float, depth_um: float, domain_um: float = 240.0, contact_mode: str = "grid",
+def tabor_scene(h_um: float, depth_um: float, domain_um: float = 240.0, contact_mode: str = Discretisation.contact,
                 particles_per_cell: int = 2, press_speed_fraction: float = QUASI_STATIC_PRESS_FRACTION) -> Scene:
     """The sphere held ``depth_um`` deep in the rigid-plastic block of the uncoated reference scene (H = 900 MPa,
     sigma_y = 300 MPa, E = 210 GPa; frictionless), pressed at ``press_speed_fraction`` of 0.1 m/s."""

@@ -340,10 +340,12 @@ class Discretisation:
     particles lie frozen beyond an end of the zone, the block's own end face there stays free.
     None (default) updates every particle (docs/journal/2026-11-23-active-zone.md).
 
-    ``contact``: "grid" (default) imposes the sphere on the grid nodes within a cell of it, each limited by
-    the gap of its closest stencil particle (:func:`plough.mpm.contact.sphere_contact`); "grid_local" the same
-    with the gap of the closest particle on the node's own ray (a diagnostic: how much of the grid contact's
-    error is where it detects contact); "particle" imposes
+    ``contact``: "grid_local" (default) imposes the sphere on the grid nodes within a cell of it, each limited
+    by the gap of the closest particle within half a cell of the node's own ray from the sphere's centre
+    (:func:`plough.mpm.contact.sphere_contact`: the contact acts where the material meets the sphere; chosen
+    2026-12-04, docs/journal/2026-12-04-contact-switch.md); "grid" the same with the gap of the closest particle
+    of the node's whole stencil (the contact acts up to a cell outside the sphere; the default until then);
+    "particle" imposes
     it on each near particle whose face would cross the sphere's exact surface in the step, through the
     particle's own nodes (:func:`plough.mpm.contact.particle_contact`; docs/journal/2026-12-02-contact-candidates.md).
     """
@@ -359,7 +361,7 @@ class Discretisation:
     fine_zone_shape: str = "square"
     fine_zone_depth_particles: float | None = None
     active_zone_contact_radii: float | None = None
-    contact: str = "grid"
+    contact: str = "grid_local"
 
     def __post_init__(self) -> None:
         _finite_positive("discretisation", "particle_size_m", self.particle_size_m, "m")

@@ -517,7 +517,8 @@ def scene_for(point: Point, h_um: float, numerics: dict[str, Any]) -> Scene:
                                       fine_zone_depth_particles=_optional_float(
                                           numerics.get("fine_zone_depth_particles")),
                                       active_zone_contact_radii=_optional_float(
-                                          numerics.get("active_zone_contact_radii"))),
+                                          numerics.get("active_zone_contact_radii")),
+                                      contact=str(numerics.get("contact", Discretisation.contact))),
         outputs=Outputs(steady_window=tuple(float(x) for x in numerics["steady_window"]),
                         records=int(numerics["records"]),
                         buried_profile_depth_m=float(numerics["buried_profile_depth_um"]) * 1e-6),
