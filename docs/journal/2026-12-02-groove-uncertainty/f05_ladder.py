@@ -3,7 +3,8 @@ reference scenes at f = 0.5 (below the wave limit), workflow numerics, h = 20 / 
 to h -> 0 with its uncertainty (GCI-type and the runs' errors carried to the limit, in quadrature) against the
 analytical model.
 
-    python docs/journal/2026-12-02-groove-uncertainty/f05_ladder.py [--sizes-um 20 10 5] [--threads 2] [--out FILE]
+    python docs/journal/2026-12-02-groove-uncertainty/f05_ladder.py [--sizes-um 20 10 5] [--scenes coated uncoated]
+        [--threads 2] [--out FILE]
 
 Writes f05_ladder.json beside this file (or FILE) and prints a table.
 """
@@ -44,11 +45,12 @@ def analytical(scene) -> dict[str, float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[20.0, 10.0, 5.0])
+    parser.add_argument("--scenes", nargs="+", default=["coated", "uncoated"], choices=["coated", "uncoated"])
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--out", type=Path, default=HERE / "f05_ladder.json")
     args = parser.parse_args()
     out = {"git_commit": git_commit(), "sizes_um": args.sizes_um, "scenes": {}}
-    for name in ("coated", "uncoated"):
+    for name in args.scenes:
         runs = []
         for h in args.sizes_um:
             scene = workflow_scene(name, h * 1e-6)

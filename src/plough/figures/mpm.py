@@ -39,13 +39,12 @@ QUANTITY = {"dp": ("ploughing depth dp (µm)", 1e6), "mu": ("friction coefficien
 #: what a row of Figs. 11 / 13 shows, in its panels' titles
 ROW_TITLES = {"dp": "ploughing depth dp", "mu": "friction mu", "mu_pl": "ploughing part mu_pl",
               "mu_sh": "interface-shear part mu_sh"}
-#: Fig. 13's rows: mu and its two parts. At strong interface shear the MPM's contact grows (junction growth;
-#: a prow on coated scenes) while the analytical model fixes its area at Fn / H, so the MPM's mu_sh is not
-#: expected to equal the analytical one, its mu_pl is: mu alone would hide which part departs
-#: (docs/journal/2026-12-02-interface-shear-split.md)
+#: Fig. 13's rows: mu and its two parts. The analytical model takes the interface part on an area fixed at
+#: Fn / H, the MPM on its own contact (which with the grid contact grows under shear, and on coated scenes
+#: carries a prow): mu alone would hide which part departs (docs/journal/2026-12-02-interface-shear-split.md)
 FIG13_ROWS = ("mu", "mu_pl", "mu_sh")
-FIG13_NOTE = ("note: mu_sh is the interface part. The analytical model takes it on the projected front area Fn / H;\n"
-              "the MPM's contact grows under shear (docs/journal/2026-12-02-interface-shear-split.md)")
+FIG13_NOTE = ("note: mu_sh is the interface part. The analytical model takes it on the projected front area Fn / H,\n"
+              "the MPM on its own contact (docs/journal/2026-12-02-interface-shear-split.md)")
 #: the extrapolated marks and the line joining them (the trend), drawn above their bars
 MARK_SIZE = 6.0
 TREND_WIDTH = 1.6
