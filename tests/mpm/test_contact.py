@@ -348,7 +348,7 @@ def test_scatter_contact_stress_writes_only_nodes_near_the_sphere():
     rest_flow_stresses(eps_p, temperature, mat_a, mat_b, frac_a, table, sigma_y0)
     P = particles_of(n, x=x, stress=stress, mass=mass, vol0=vol0, J=J, sigma_y0=sigma_y0, near=near)
     ct.scatter_contact_stress(P, grid_of(ORIGIN, DX, SHAPE, cbuf=cbuf), SphereData(centre, np.zeros(3), radius, 3 * DX),
-                              whole(n, SHAPE))
+                              whole(n, SHAPE), False)
     # independent accumulation
     sy = np.array([450e6 / 3, 900e6 / 3])
     kappa = (frac_a * sy[mat_a] + (1 - frac_a) * sy[mat_b]) / math.sqrt(3.0)
@@ -498,7 +498,7 @@ def _scatter_block(x, h, centre, radius, mirror_j0=-1):
                        pack_materials([rigid_plastic("sub", 900e6, coating=False)]), sigma_y0)
     G = grid_of(ORIGIN, DX, SHAPE, mirror_j0=mirror_j0)
     P = particles_of(n, x=x, vol0=np.full(n, (h * DX) ** 3), sigma_y0=sigma_y0, near=np.ones(n, dtype=np.int8))
-    ct.scatter_contact_stress(P, G, SphereData(np.asarray(centre), np.zeros(3), radius, 3 * DX), whole(n, SHAPE))
+    ct.scatter_contact_stress(P, G, SphereData(np.asarray(centre), np.zeros(3), radius, 3 * DX), whole(n, SHAPE), False)
     return G.cbuf
 
 

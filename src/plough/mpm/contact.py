@@ -126,7 +126,7 @@ def _inside_box(origin, dx, shape, centre, radius):
 
 
 @njit(cache=True)
-def scatter_contact_stress(P, G, S, Z, ray_local=False):
+def scatter_contact_stress(P, G, S, Z, ray_local):
     """Mass-weighted stress and shear strength, and the surface vector, of the particles near the
     sphere onto nearby nodes.
 
@@ -139,7 +139,7 @@ def scatter_contact_stress(P, G, S, Z, ray_local=False):
     G.cbuf[node, C_AREA:C_AREA + 3] += V grad w (the node's share of the material's surface, as a
     vector). With the mirror plane (``G.mirror_j0`` >= 0, else -1) the surface vector of a ghost node
     (y < 0) goes to its partner with its y component reversed: the mirrored particles' share.
-    With ``ray_local`` (the position-corrected variant, ``discretisation.contact: grid_local``) a particle sets a
+    With ``ray_local`` (``discretisation.contact: grid_local``, the default; False: ``grid``) a particle sets a
     node's proximity only if it lies within half a cell of the node's ray from the sphere's centre (the gap of the
     material *at the node*, not of its whole stencil; the stress, strength and surface sums are unchanged).
     Serial: few particles are near the sphere. ``sphere_contact`` consumes and re-zeroes these entries.
