@@ -12,7 +12,7 @@ phi = 0, 1/N, ..., (N-1)/N. The spread of mu and dp over the phases is the noise
 run: two settings whose results differ by less than it cannot be told apart with one run each. It
 is set beside each run's own error (``mu_standard_error``: the jackknife over the steady window's
 records; ``dp_standard_error``, ``dg_...``, ``hpu_...``: the jackknife over the residual sections and
-the lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H * h`` in quadrature, ``plough.mpm.io``) to see
+the contact's lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H[contact] * h`` in quadrature, ``plough.mpm.io``) to see
 whether that error, which every result file carries, measures this noise: per quantity the median
 error, the spread over its median, and the root mean square of the runs' z-scores
 ``(value - mean over the phases) / error * sqrt(n / (n - 1))`` (1 for a calibrated error, below 1 for

@@ -13,7 +13,7 @@ import xarray as xr
 
 from plough.mpm import io
 from plough.mpm.io import residual_profiles
-from plough.mpm.scene import Scene
+from plough.mpm.scene import CONTACT_MODES, Scene
 
 ROOT = Path(__file__).resolve().parents[2]
 
@@ -389,7 +389,8 @@ def test_standard_errors_of_the_window_and_the_sections():
     depth = np.array([2e-6, 4e-6, 2e-6, 4e-6])  # four sections, two groove depths; pile-up 1 um
     prof = np.array([[-d, -d, 0.0, 1e-6] for d in depth])
     h = 5e-6
-    out = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, particle_size_m=h)
+    phase = io.GROOVE_LATTICE_PHASE_ERROR_H["grid"] * h
+    out = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, lattice_phase_term_m=phase)
     theta = np.array([(fx[20:].sum() - fx[20 + 2 * b: 22 + 2 * b].sum()) / (fz[20:].sum() - 4.0) for b in range(k)])
     expected = np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2))
     assert out["mu_standard_error"] == pytest.approx(expected, rel=1e-12) and expected > 0
@@ -398,17 +399,30 @@ def test_standard_errors_of_the_window_and_the_sections():
     # dp = mean depth + 1 um; leave one section of four out: depth 8/3 or 10/3 um, two each
     dp_theta = np.array([10 / 3, 8 / 3, 10 / 3, 8 / 3]) * 1e-6
     dp_expected = np.sqrt(3 / 4 * np.sum((dp_theta - dp_theta.mean()) ** 2))
-    phase = io.GROOVE_LATTICE_PHASE_ERROR_H * h
     assert 0 < phase < dp_expected
     assert out["dp_standard_error"] == pytest.approx(np.hypot(dp_expected, phase), rel=1e-12)
     assert out["dg_standard_error"] == pytest.approx(np.hypot(dp_expected, phase), rel=1e-12)  # dg carries dp's scatter
     assert out["hpu_standard_error"] == pytest.approx(phase, rel=1e-12)  # the same pile-up in every section
-    no_phase = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, particle_size_m=0.0)
+    no_phase = io.standard_errors(series, mask, y, prof, contact_radius=15e-6, lattice_phase_term_m=0.0)
     assert no_phase["dp_standard_error"] == pytest.approx(dp_expected, rel=1e-12)
     assert no_phase["hpu_standard_error"] == 0.0
     # one section: the groove's errors cannot be estimated and are left out, not written as NaN or 0
-    one = io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6, particle_size_m=h)
+    one = io.standard_errors(series, mask, y, prof[:1], contact_radius=15e-6, lattice_phase_term_m=phase)
     assert not {"dp_standard_error", "dg_standard_error", "hpu_standard_error"} & set(one)
+
+
+def test_the_groove_lattice_phase_term_follows_the_contact():
+    """Every contact has a term; the grid's is a tenth of the particle size (its phase spread), grid_local's none
+    (its spread is a thousandth of the grid's), the unmeasured particle contact the grid's (the safe side)."""
+    assert set(io.GROOVE_LATTICE_PHASE_ERROR_H) == set(CONTACT_MODES)
+    scene = Scene.from_dict({"load_N": 1.0, "sphere": {"radius_um": 200},
+                             "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}},
+                             "discretisation": {"particle_size_um": 10}})
+    terms = {mode: io.groove_lattice_phase_term_m(replace(scene, discretisation=replace(scene.discretisation,
+                                                                                          contact=mode)))
+             for mode in CONTACT_MODES}
+    tenth = pytest.approx(1e-6, rel=1e-12)
+    assert terms == {"grid": tenth, "grid_local": 0.0, "particle": tenth}
 
 
 def test_contact_summary_of_the_shear_split():

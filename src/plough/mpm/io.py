@@ -137,12 +137,16 @@ STEADY_META = {
 
 #: contiguous batches the steady window's records and the residual sections are cut into for the jackknife
 SE_BATCHES = 10
-#: one run's groove (dg, hpu, dp) moves with where the sphere starts against the particle lattice by up to about a
-#: tenth of a particle size beyond what the jackknife over the residual sections sees: this term, times the particle
-#: size, is added to their standard errors in quadrature (calibrated on phase-shifted runs: docs/verification.md,
-#: "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md; for hpu, whose noise is smaller, it
-#: errs on the safe side)
-GROOVE_LATTICE_PHASE_ERROR_H = 0.1
+#: one run's groove (dg, hpu, dp) moves with where the sphere starts against the particle lattice beyond what the
+#: jackknife over the residual sections sees, by an amount that depends on the contact: this fraction of the
+#: particle size is added to their standard errors in quadrature. The grid contact closes nodes by its particles'
+#: whole stencils, a discrete choice a shifted start changes: a tenth of a particle size covers its phase spread
+#: (rms z 0.44 over 60 runs, two cases need the term). With the gap on each node's own ray (grid_local) the groove
+#: does not remember the start (spread 0.02-0.07% of dp) and the jackknife alone already overstates it (rms z
+#: 0.59 over 12 runs at h = 10 um): no term. The particle contact was never measured: the grid's, on the safe
+#: side (docs/verification.md, "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md,
+#: docs/journal/2026-12-04-preview-grid-local.md)
+GROOVE_LATTICE_PHASE_ERROR_H = {"grid": 0.1, "grid_local": 0.0, "particle": 0.1}
 GROOVE_OUTPUTS = ("dp", "dg", "hpu")
 STANDARD_ERROR_META = {
     f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over up to {SE_BATCHES} "
@@ -150,9 +154,8 @@ STANDARD_ERROR_META = {
     for name in ("mu", "mu_pl", "mu_sh")
 } | {
     f"{name}_standard_error": ("m", f"standard error of {name}: the jackknife over up to {SE_BATCHES} contiguous "
-                                    "batches of the residual sections and the lattice-phase term "
-                                    f"{GROOVE_LATTICE_PHASE_ERROR_H:g} h (attribute lattice_phase_term_m) in "
-                                    "quadrature")
+                                    "batches of the residual sections and the contact's lattice-phase term "
+                                    "(attribute lattice_phase_term_m) in quadrature")
     for name in GROOVE_OUTPUTS
 }
 
@@ -396,17 +399,24 @@ def jackknife_standard_error(statistic: Callable[[np.ndarray], float], n: int,
     return float(np.sqrt((k - 1) / k * np.sum((theta - theta.mean()) ** 2)))
 
 
+def groove_lattice_phase_term_m(scene: Scene) -> float:
+    """The lattice-phase term of the scene's groove errors (m): ``GROOVE_LATTICE_PHASE_ERROR_H`` of its contact
+    times its particle size."""
+    d = scene.discretisation
+    return GROOVE_LATTICE_PHASE_ERROR_H[d.contact] * d.particle_size_m
+
+
 def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarray, prof: np.ndarray,
-                    contact_radius: float, particle_size_m: float) -> dict[str, float]:
+                    contact_radius: float, lattice_phase_term_m: float) -> dict[str, float]:
     """Standard errors of the steady-state results (``STANDARD_ERROR_META``).
 
     The steady window is a finite sample of a fluctuating force and the residual groove a finite
     number of sections: the jackknife estimates how far the same run with a different but equally
     long sample would move mu and the groove. The groove's errors (dp, dg, hpu) also carry the
-    lattice-phase term ``GROOVE_LATTICE_PHASE_ERROR_H * particle_size_m`` in quadrature: where the
-    sphere starts against the particle lattice moves the groove by up to about a tenth of a particle
-    size beyond the jackknife's reach (a groove a fraction of a particle deep shows no scatter over its
-    sections at all). mu's errors carry no such term: measured against phase-shifted runs they are
+    lattice-phase term ``lattice_phase_term_m`` (:func:`groove_lattice_phase_term_m`) in quadrature: with the
+    grid contact where the sphere starts against the particle lattice moves the groove by up to about a tenth
+    of a particle size beyond the jackknife's reach (a groove a fraction of a particle deep shows no scatter
+    over its sections at all). mu's errors carry no such term: measured against phase-shifted runs they are
     order-of-magnitude bars (docs/verification.md, "Noise and reproducibility"). The groove's errors are
     omitted when fewer than 2 sections were measured.
     """
@@ -417,7 +427,7 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
         se = jackknife_standard_error(lambda k, part=part: part[k].sum() / fz[k].sum(), idx.size)
         if se is not None:
             out[f"{name}_standard_error"] = se
-    phase = GROOVE_LATTICE_PHASE_ERROR_H * particle_size_m
+    phase = lattice_phase_term_m
     groove = {"dp": sum, "dg": lambda d: d[0], "hpu": lambda d: d[1]}
     for name, pick in groove.items():
         se = jackknife_standard_error(
@@ -546,11 +556,12 @@ def build_dataset(scene: Scene, series: dict[str, np.ndarray], slid_m: np.ndarra
             u, ln = CONTACT_SUMMARY_META[name]
             ds[name] = ((), float(value), {"units": u, "long_name": ln})
     h = scene.discretisation.particle_size_m
-    for name, value in standard_errors(series, mask, y, prof, a_exp, h).items():
+    phase_term = groove_lattice_phase_term_m(scene)
+    for name, value in standard_errors(series, mask, y, prof, a_exp, phase_term).items():
         u, ln = STANDARD_ERROR_META[name]
         ds[name] = ((), float(value), {"units": u, "long_name": ln})
         if name.removesuffix("_standard_error") in GROOVE_OUTPUTS:
-            ds[name].attrs["lattice_phase_term_m"] = GROOVE_LATTICE_PHASE_ERROR_H * h
+            ds[name].attrs["lattice_phase_term_m"] = phase_term
     for name, value in steadiness(series, mask, h).items():
         u, ln = STEADINESS_META[name]
         ds[name] = ((), np.int8(value) if name == "steady" else value, {"units": u, "long_name": ln})
