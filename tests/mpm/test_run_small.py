@@ -164,7 +164,7 @@ def test_steadiness_is_reported_from_the_run_records(tiny_run, tiny_scene):
 def test_standard_errors_are_written_from_the_run_records(tiny_run, tiny_scene):
     """mu's sampling error is the jackknife over the window's own records (recomputed here from the
     file's series), with units; the groove's (dp, dg, hpu) are at least the contact's lattice-phase term
-    (none for the default grid_local), which each carries as an attribute."""
+    (0.002 h for the default grid_local), which each carries as an attribute."""
     ds = tiny_run
     mask = ds.in_steady_window.values
     series = {q: ds[q].values for q in ("Fx", "Fz", "Fx_pl", "Fx_sh")}

@@ -142,11 +142,12 @@ SE_BATCHES = 10
 #: particle size is added to their standard errors in quadrature. The grid contact closes nodes by its particles'
 #: whole stencils, a discrete choice a shifted start changes: a tenth of a particle size covers its phase spread
 #: (rms z 0.44 over 60 runs, two cases need the term). With the gap on each node's own ray (grid_local) the groove
-#: does not remember the start (spread 0.02-0.07% of dp) and the jackknife alone already overstates it (rms z
-#: 0.59 over 12 runs at h = 10 um): no term. The particle contact was never measured: the grid's, on the safe
-#: side (docs/verification.md, "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md,
+#: hardly remembers the start (dp moves 0.02-1.4% at h = 10-20 um, 0.0013 h at most): the jackknife alone covers dp
+#: and dg but not the pile-up height at h = 20 um (rms z 1.68 / 1.19 on two of six cases), and 0.002 h covers
+#: every case measured (rms z at most 0.53, 24 runs). The particle contact was never measured: the grid's, on the
+#: safe side (docs/verification.md, "Noise and reproducibility"; docs/journal/2026-12-02-groove-uncertainty.md,
 #: docs/journal/2026-12-04-preview-grid-local.md)
-GROOVE_LATTICE_PHASE_ERROR_H = {"grid": 0.1, "grid_local": 0.0, "particle": 0.1}
+GROOVE_LATTICE_PHASE_ERROR_H = {"grid": 0.1, "grid_local": 0.002, "particle": 0.1}
 GROOVE_OUTPUTS = ("dp", "dg", "hpu")
 STANDARD_ERROR_META = {
     f"{name}_standard_error": ("1", f"sampling standard error of {name} (jackknife over up to {SE_BATCHES} "
