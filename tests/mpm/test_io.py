@@ -413,7 +413,7 @@ def test_standard_errors_of_the_window_and_the_sections():
 
 def test_the_groove_lattice_phase_term_follows_the_contact():
     """Every contact has a term; the grid's is a tenth of the particle size (its phase spread), grid_local's 0.002
-    of it (its spread is a hundredth of the grid's or less), the unmeasured particle contact the grid's (the safe
+    of it (its spread is a tenth of the grid's or less), the unmeasured particle contact the grid's (the safe
     side)."""
     assert set(io.GROOVE_LATTICE_PHASE_ERROR_H) == set(CONTACT_MODES)
     scene = Scene.from_dict({"load_N": 1.0, "sphere": {"radius_um": 200},

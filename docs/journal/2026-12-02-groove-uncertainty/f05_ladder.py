@@ -49,6 +49,8 @@ def main() -> None:
     parser.add_argument("--threads", type=int, default=2)
     parser.add_argument("--out", type=Path, default=HERE / "f05_ladder.json")
     args = parser.parse_args()
+    if len(args.sizes_um) < 2 and "--out" not in sys.argv:
+        parser.error(f"--sizes-um {args.sizes_um[0]:g} alone needs --out FILE: one size would overwrite {args.out}")
     out = {"git_commit": git_commit(), "sizes_um": args.sizes_um, "scenes": {}}
     for name in args.scenes:
         runs = []
@@ -68,7 +70,7 @@ def main() -> None:
                   flush=True)
         ana = analytical(scene)
         limits = {}
-        for o in OUTPUTS if len(runs) >= 2 else ():  # one size (a finer run to add to a file's ladder): no limit
+        for o in OUTPUTS if len(runs) >= 2 else ():  # one size: the run's row alone, no limit
             f = np.array([r[o] for r in runs])
             se = np.array([r[f"{o}_standard_error"] for r in runs])
             ex = extrapolate(args.sizes_um, f)
