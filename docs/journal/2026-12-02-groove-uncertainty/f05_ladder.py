@@ -47,10 +47,12 @@ def main() -> None:
     parser.add_argument("--sizes-um", type=float, nargs="+", default=[20.0, 10.0, 5.0])
     parser.add_argument("--scenes", nargs="+", default=["coated", "uncoated"], choices=["coated", "uncoated"])
     parser.add_argument("--threads", type=int, default=2)
-    parser.add_argument("--out", type=Path, default=HERE / "f05_ladder.json")
+    parser.add_argument("--out", type=Path, help="default: f05_ladder.json beside this script (two sizes or more)")
     args = parser.parse_args()
-    if len(args.sizes_um) < 2 and "--out" not in sys.argv:
-        parser.error(f"--sizes-um {args.sizes_um[0]:g} alone needs --out FILE: one size would overwrite {args.out}")
+    if args.out is None:
+        if len(args.sizes_um) < 2:
+            parser.error("one size needs --out FILE: its row alone would overwrite the ladder file beside this script")
+        args.out = HERE / "f05_ladder.json"
     out = {"git_commit": git_commit(), "sizes_um": args.sizes_um, "scenes": {}}
     for name in args.scenes:
         runs = []

@@ -22,16 +22,19 @@ import numpy as np
 import xarray as xr
 import yaml
 
-from plough.mpm.io import GROOVE_LATTICE_PHASE_ERROR_H
+from plough.mpm.io import groove_lattice_phase_term_m
+from plough.mpm.scene import Scene
 from plough.study import matrix, skipping
 
 
 def with_grid_local_term(run: xr.Dataset) -> xr.Dataset:
-    """The run with its groove errors' lattice-phase term (the grid's, as written) replaced by grid_local's, as the
-    solver writes them since the term follows the contact (plough.mpm.io.GROOVE_LATTICE_PHASE_ERROR_H)."""
+    """The run with its groove errors' lattice-phase term (as written: the grid's before the term followed the
+    contact) replaced by the one the solver now writes for its contact, which must be grid_local."""
+    scene = Scene.from_dict(json.loads(run.attrs["scene"]))
+    if scene.discretisation.contact != "grid_local":
+        raise SystemExit(f"a preview run with contact {scene.discretisation.contact!r}: this reading needs grid_local")
+    new = groove_lattice_phase_term_m(scene)
     run = run.copy()
-    h = skipping.run_size_um(run) * 1e-6
-    new = GROOVE_LATTICE_PHASE_ERROR_H["grid_local"] * h
     for q in ("dp", "dg", "hpu"):
         name = f"{q}_standard_error"
         if name in run:
@@ -57,24 +60,21 @@ def main() -> None:
             continue
         with xr.open_dataset(coarse) as c, xr.open_dataset(mid) as m:
             c, m = c.load(), m.load()
-        for run in (c, m):
-            contact = json.loads(run.attrs["scene"])["discretisation"]["contact"]
-            if contact != "grid_local":
-                raise SystemExit(f"{key}: a preview run with contact {contact!r}; this reading assumes grid_local")
-        # the run the decision is about: the point's finest where 20 / 10 um is its pair, else the 5 um run
-        finest = matrix.run_id(point, sizes[2]) if tuple(sizes[:2]) == (20.0, 10.0) else f"{key}_h5"
+        # the decision itself where the point's own coarser pair is 20 / 10 um (about its finest run), else a pair
+        # coarser or finer than its own (about the 5 um run)
+        exact = tuple(sizes[:2]) == (20.0, 10.0)
+        finest = matrix.run_id(point, sizes[2]) if exact else f"{key}_h5"
         d = skipping.decide(finest, c, m, [coarse.stem, mid.stem], tolerance)
         local = skipping.decide(finest, with_grid_local_term(c), with_grid_local_term(m), [coarse.stem, mid.stem],
                                tolerance)
         d["with_grid_local_term"] = {"run_finest": local["run_finest"], "extrapolations": local["extrapolations"]}
-        # the decision itself where the point's own coarser pair is 20 / 10 um, else a pair coarser or finer
-        d["exact"] = tuple(sizes[:2]) == (20.0, 10.0)
+        d["exact"] = exact
         d["ladder_um"] = list(sizes)
         rows.append({"point": key, **d})
-        ex, exb = d["extrapolations"], local["extrapolations"]
+        ex, exl = d["extrapolations"], local["extrapolations"]
         print(f"{key:52s} {'/'.join(f'{h:g}' for h in sizes):11s} mu {ex['mu']['value']:.4f} "
               f"rel {ex['mu']['relative_uncertainty']:.3f}  dp {ex['dp']['value'] * 1e6:6.2f} um "
-              f"rel {ex['dp']['relative_uncertainty']:.3f} / {exb['dp']['relative_uncertainty']:.3f}  "
+              f"rel {ex['dp']['relative_uncertainty']:.3f} / {exl['dp']['relative_uncertainty']:.3f}  "
               f"{'skip' if not d['run_finest'] else 'run'} / {'skip' if not local['run_finest'] else 'run'}"
               f"{'' if d['exact'] else ' (not its pair)'}")
     args.out.write_text(json.dumps(rows, indent=1))
