@@ -43,6 +43,15 @@ def simulate_seconds(result: Path) -> float:
         return float(ds.attrs.get("cost_wall_time_s", float("nan")))
 
 
+def run_threads(result: Path, default: int) -> int:
+    """The threads the run ran at (``cost_threads`` of its result), ``default`` (the config's) for a marker or a
+    missing file."""
+    if not result.exists():
+        return default
+    with xr.open_dataset(result) as ds:
+        return int(ds.attrs.get("cost_threads", default))
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--workdir", type=Path, required=True, help="where the workflow ran")
@@ -67,7 +76,8 @@ def main() -> None:
                      "family": "real materials" if real else "rigid-plastic", "system": system,
                      "particles": c.particles,
                      "particle_steps": c.particle_steps, "projected_s": projected,
-                     "measured_s": measured_seconds(tsv), "simulate_s": simulate_seconds(result)})
+                     "measured_s": measured_seconds(tsv), "simulate_s": simulate_seconds(result),
+                     "threads": run_threads(result, int(config["mpm"]["threads"]))})
     if not rows:
         raise SystemExit(f"no benchmark file of this config's runs under {args.workdir / 'benchmarks' / 'runs'}")
     print(f"{len(rows)} of {len(matrix.all_runs(config))} runs measured\n")
@@ -94,7 +104,8 @@ def main() -> None:
         print(f"| {label} | {family} | {len(group)} | {proj / 60:.1f} min | {meas / 60:.1f} min "
               f"({overhead / 60:.1f} min start-up and writing) | {meas / proj:.2f} ({sim / proj:.2f} without), "
               f"{statistics.median(ratios):.2f} ({min(ratios):.2f}-{max(ratios):.2f}) |")
-    Path(args.out).write_text(json.dumps({"config": args.config, "workdir": str(args.workdir),
+    Path(args.out).write_text(json.dumps({"config": args.config, "threads": int(config["mpm"]["threads"]),
+                                          "workdir": str(args.workdir),
                                           "throughput_particle_steps_per_s": throughput,
                                           "real_material_throughput_factor": material_factor,
                                           "summary": summary, "runs": rows}, indent=2) + "\n")

@@ -136,3 +136,27 @@ def test_refinement_checkpoint_decides_then_asks_only_for_the_needed_finest_runs
     assert "not needed" in (work / "logs/datasets/fig15.log").read_text()
     counts, _ = dry()
     assert counts == {}  # nothing left to do
+
+
+def test_the_longest_runs_start_first(workdir):
+    """Each MPM run's priority is its counted particle-steps (in thousands), so that with several runs at once
+    (--cores over mpm.threads) the scheduler starts the longest first and none is left to finish alone."""
+    import yaml
+
+    sys.path.insert(0, str(ROOT / "src"))
+    from plough.mpm.scene import Scene
+    from plough.study import cost, matrix
+
+    config = yaml.safe_load((workdir / "config/smoke.yaml").read_text())
+    runs = matrix.all_runs(config)
+    out = _snakemake(workdir, "--configfile=config/smoke.yaml", "-n", "--forceall", "results/datasets/fig15.nc")
+    assert out.returncode == 0, out.stderr[-3000:]
+    listed = {}
+    for block in (out.stdout + out.stderr).split("rule ")[1:]:
+        if block.startswith("mpm_run:"):
+            run = block.split("wildcards: run=")[1].split()[0]
+            listed[run] = int(block.split("priority: ")[1].split()[0])
+    assert len(listed) >= 4
+    for run, priority in listed.items():
+        assert priority == int(cost.estimate(Scene.from_dict(runs[run])).particle_steps // 1e3), run
+    assert len(set(listed.values())) > 1  # the runs differ, and so do their priorities

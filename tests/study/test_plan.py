@@ -18,7 +18,17 @@ from plough.cli import main
 from plough.io import to_json
 from plough.mpm.scene import Scene
 from plough.study import cost, matrix
-from plough.study.plan import Measured, Rates, _hours, load_config, make_plan, measured_from_benchmarks, merge
+from plough.study.plan import (
+    UNRECORDED_THREADS,
+    Measured,
+    Rates,
+    _hours,
+    load_config,
+    make_plan,
+    measured_from_benchmarks,
+    measured_from_json,
+    merge,
+)
 
 ROOT = Path(__file__).resolve().parents[2]
 SMOKE = yaml.safe_load((ROOT / "config" / "smoke.yaml").read_text())
@@ -60,6 +70,21 @@ def _calibration(tmp_path: Path, rows: list[dict]) -> Path:
     path = tmp_path / "projection_check_test.json"
     path.write_text(json.dumps({"config": "none.yaml", "runs": rows}))
     return path
+
+
+def test_calibration_rows_carry_the_threads_they_ran_at(tmp_path):
+    """A projection_check.py result's rows run at the threads the row records, else the file, else 2 (every file
+    before the record was measured at mpm.threads 2): never at the threads today's copy of a named config has."""
+    row = {"family": "rigid-plastic", "h_um": 10.0, "particle_steps": 1e8, "measured_s": 100.0}
+    named = tmp_path / "named.yaml"
+    named.write_text(yaml.safe_dump({"mpm": {"threads": 7}}))
+    files = {"old.json": {"config": str(named), "runs": [{**row, "run": "a"}]},
+             "file.json": {"config": str(named), "threads": 1, "runs": [{**row, "run": "b"}]},
+             "rows.json": {"threads": 1, "runs": [{**row, "run": "c", "threads": 4}, {**row, "run": "d"}]}}
+    for name, data in files.items():
+        (tmp_path / name).write_text(json.dumps(data))
+    threads = {r.run: r.threads for r in measured_from_json(sorted(tmp_path.glob("*.json")))}
+    assert threads == {"a": UNRECORDED_THREADS, "b": 1, "c": 4, "d": 1} and UNRECORDED_THREADS == 2
 
 
 def test_the_plan_of_a_config_from_measured_jobs(tmp_path):

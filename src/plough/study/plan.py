@@ -97,23 +97,23 @@ def family_of(scene: Any) -> str:
     return "rigid-plastic" if constant else "real materials"
 
 
-def measured_from_json(paths: Iterable[Path]) -> list[Measured]:
-    """The rows of ``projection_check.py`` results, at the threads of the config each names (2 if unknown)."""
-    import yaml
+#: the threads a run of a ``projection_check.py`` result ran at where the file does not say: every file written
+#: before it recorded them was measured with ``mpm.threads: 2`` (the config files named in them say so at the
+#: commits that made them; today's content of a named config says nothing about a past measurement)
+UNRECORDED_THREADS = 2
 
+
+def measured_from_json(paths: Iterable[Path]) -> list[Measured]:
+    """The rows of ``projection_check.py`` results, each at the threads it records (``threads`` of the row, else
+    of the file, else ``UNRECORDED_THREADS``)."""
     rows = []
     for path in sorted(paths):
         data = json.loads(path.read_text())
-        threads = 2
-        named = data.get("config")
-        for candidate in (Path(named), path.parents[2] / named) if named else ():
-            if candidate.exists():
-                threads = int(yaml.safe_load(candidate.read_text())["mpm"]["threads"])
-                break
+        threads = int(data.get("threads", UNRECORDED_THREADS))
         for r in data["runs"]:
             if math.isfinite(r.get("measured_s", math.nan)) and r["measured_s"] > 0:
                 rows.append(Measured(r["run"], r["family"], float(r["h_um"]), float(r["particle_steps"]),
-                                     float(r["measured_s"]), threads, str(path)))
+                                     float(r["measured_s"]), int(r.get("threads", threads)), str(path)))
     return rows
 
 
@@ -313,10 +313,16 @@ def describe(plan: Plan, *, points: bool = False) -> str:
             text = ", ".join(f"h = {h:g} um {rate / 1e6:.2f} M/s ({n} jobs)" for h, (n, rate) in sorted(by_h.items()))
         else:
             text = f"none measured: {plan.rates.rate(fam, 1.0) / 1e6:.2f} M/s (plough.study.cost.THROUGHPUT_PER_THREAD)"
-        lines.append(f"  {fam}, particle-steps per second of a job at {plan.threads} threads: {text}")
+        lines.append(f"  {fam}, particle-steps per second of a job at {_threads(plan.threads)}: {text}")
+    other = sorted({r.threads for r in plan.measured} - {plan.threads})
+    if other:
+        # linear in the threads: conservative for fewer threads a run (two one-thread runs at once measured 1.31x
+        # the throughput of one two-thread run here: docs/performance.md, "Two runs at once")
+        lines.append(f"  (jobs measured at {', '.join(map(str, other))} threads scaled linearly to "
+                     f"{_threads(plan.threads)} a run)")
     lines.append("")
-    lines.append(f"| figure | MPM runs | particle-steps | here (--cores {plan.cores}, {plan.threads} threads a run) | "
-                 f"longest job here | longest job on the cluster ({plan.cluster_threads} threads) |")
+    lines.append(f"| figure | MPM runs | particle-steps | here (--cores {plan.cores}, {_threads(plan.threads)} "
+                 f"a run) | longest job here | longest job on the cluster ({plan.cluster_threads} threads) |")
     lines.append("|---|---|---|---|---|---|")
     for fig, rids in plan.figures.items():
         if not rids:
@@ -390,6 +396,10 @@ def _sources(sources: list[str]) -> list[str]:
     files = [s for s in sources if not s.endswith(".tsv")]
     tsv = [s for s in sources if s.endswith(".tsv")]
     return files + ([f"{len(tsv)} files in {Path(tsv[0]).parent}"] if tsv else [])
+
+
+def _threads(n: int) -> str:
+    return f"{n} thread" + ("s" if n != 1 else "")
 
 
 def _short(path: str) -> str:
