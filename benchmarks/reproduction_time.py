@@ -5,7 +5,8 @@
 Counts the particles and steps of every MPM run of the config (plough.study.cost, within a few
 per cent of the solver's counts) and divides by the particle-steps per second measured on the
 reference scene at 2 threads (benchmarks/results/mpm_reference_sized.json, the slowest of its sizes).
-With `--cores 2` and 2 threads per run the runs go one after another, so the total is their sum.
+The total is their sum at that throughput, one two-thread run at a time (the workflow makes two one-thread runs
+at once, 1.1-1.3x faster: docs/performance.md, "Two runs at once"; not counted here).
 Also projected: the lower bound with `mpm.skip_finest_tolerance` set, when every finest-size sweep
 run is skipped (the pictures' finest runs always run); how many are skipped depends on the results.
 With ``numerics.graded`` on, the particle counts are the graded ones and the throughput is scaled
@@ -116,17 +117,20 @@ def throughput_model(config: dict, args: argparse.Namespace) -> tuple[float, flo
 def calibration_ratios(paths: list[str], throughput: float, material_factor: float
                        ) -> dict[str, dict[float, tuple[int, float]]]:
     """family -> h (um) -> (runs, sum of measured job seconds / sum of projected seconds) over the
-    ``projection_check.py`` files' rows (a run in several files counts once, its last measurement)."""
+    ``projection_check.py`` files' rows (a run in several files counts once, its last measurement); a job
+    measured at other threads than the projection's 2 is scaled linearly to 2 (``threads`` of the row or the
+    file; 2 where neither says, as every file written before they recorded it was measured)."""
     rows: dict[str, dict] = {}
     for path in paths:
-        for r in json.loads(Path(path).read_text())["runs"]:
-            rows[r["run"]] = r
+        data = json.loads(Path(path).read_text())
+        for r in data["runs"]:
+            rows[r["run"]] = {**r, "threads": r.get("threads", data.get("threads", 2))}
     sums: dict[str, dict[float, list[float]]] = {}
     for r in rows.values():
         rate = throughput * (material_factor if r["family"] == "real materials" else 1.0)
         acc = sums.setdefault(r["family"], {}).setdefault(float(r["h_um"]), [0, 0.0, 0.0])
         acc[0] += 1
-        acc[1] += r["measured_s"]
+        acc[1] += r["measured_s"] * r["threads"] / 2
         acc[2] += r["particle_steps"] / rate
     return {fam: {h: (int(a[0]), a[1] / a[2]) for h, a in by_h.items()} for fam, by_h in sums.items()}
 

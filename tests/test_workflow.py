@@ -1,6 +1,7 @@
 """The Snakemake workflow driven from pytest in a temporary copy (smoke config)."""
 
 import math
+import re
 import shutil
 import subprocess
 import sys
@@ -160,3 +161,27 @@ def test_the_longest_runs_start_first(workdir):
     for run, priority in listed.items():
         assert priority == int(cost.estimate(Scene.from_dict(runs[run])).particle_steps // 1e3), run
     assert len(set(listed.values())) > 1  # the runs differ, and so do their priorities
+
+
+def test_refinement_decisions_go_before_any_run(tmp_path):
+    """The default config's refinement decisions (seconds each) have a priority above every run's, so that the
+    finest runs they let in (the longest of all) join the queue as soon as their coarser runs are made."""
+    for name in ("Snakefile", "config", "workflow"):
+        src = ROOT / name
+        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / name)
+    (tmp_path / "src").symlink_to(ROOT / "src")
+    out = _snakemake(tmp_path, "-n")
+    assert out.returncode == 0, out.stderr[-3000:]
+    priorities: dict[str, list[int]] = {}
+    for block in re.split(r"\n(?:rule|checkpoint) ", out.stdout + out.stderr)[1:]:
+        rule = block.split(":")[0]
+        if rule in ("mpm_run", "mpm_refine"):
+            priorities.setdefault(rule, []).append(int(block.split("priority: ")[1].split()[0]))
+    import yaml
+
+    sys.path.insert(0, str(ROOT / "src"))
+    from plough.study import matrix
+
+    gated = matrix.skippable_runs(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
+    assert len(priorities["mpm_refine"]) == len(gated) > 0 and len(set(priorities["mpm_refine"])) == 1
+    assert priorities["mpm_refine"][0] > max(priorities["mpm_run"])

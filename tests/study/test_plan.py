@@ -19,7 +19,6 @@ from plough.io import to_json
 from plough.mpm.scene import Scene
 from plough.study import cost, matrix
 from plough.study.plan import (
-    UNRECORDED_THREADS,
     Measured,
     Rates,
     _hours,
@@ -84,7 +83,7 @@ def test_calibration_rows_carry_the_threads_they_ran_at(tmp_path):
     for name, data in files.items():
         (tmp_path / name).write_text(json.dumps(data))
     threads = {r.run: r.threads for r in measured_from_json(sorted(tmp_path.glob("*.json")))}
-    assert threads == {"a": UNRECORDED_THREADS, "b": 1, "c": 4, "d": 1} and UNRECORDED_THREADS == 2
+    assert threads == {"a": 2, "b": 1, "c": 4, "d": 1}
 
 
 def test_the_plan_of_a_config_from_measured_jobs(tmp_path):
@@ -100,7 +99,7 @@ def test_the_plan_of_a_config_from_measured_jobs(tmp_path):
         s = Scene.from_dict(scene)
         real = not rid.startswith("rp_")
         steps = cost.estimate(s).particle_steps
-        # the JSON names no config file that exists: its jobs ran at 2 threads, scaled to this config's 1
+        # the JSON records no threads: its jobs ran at 2, scaled to this config's 1
         rate = 1e8 / (400.0 if real else 100.0) / 2
         assert plan.runs[rid].here_s == pytest.approx(steps / rate), rid
         assert plan.runs[rid].cluster_s == pytest.approx(steps / rate / 8), rid

@@ -42,6 +42,11 @@ MPM_RUNS = matrix.all_runs(config)
 MPM_THREADS = int(config["mpm"]["threads"])
 # particles and steps of every run, for the memory and wall-time requests of cluster jobs
 MPM_COST = {rid: cost.estimate(Scene.from_dict(scene)) for rid, scene in MPM_RUNS.items()}
+# a run's scheduling priority: its counted particle-steps in thousands, so that with several runs at once
+# (--cores over mpm.threads) the longest ready run starts first and none is left to finish alone; a
+# refinement decision (seconds) goes before any run, so that the finest runs it lets in join the queue at once
+MPM_PRIORITY = {rid: int(c.particle_steps // 1e3) for rid, c in MPM_COST.items()}
+DECISION_PRIORITY = max(MPM_PRIORITY.values(), default=0) + 1
 # finest-size runs made only where needed (mpm.skip_finest_tolerance, checkpoint mpm_refine): run id -> its
 # two coarser runs
 SKIPPABLE = matrix.skippable_runs(config)

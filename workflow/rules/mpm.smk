@@ -26,9 +26,7 @@ rule mpm_run:
     wildcard_constraints:
         run="|".join(re.escape(r) for r in MPM_RUNS) if MPM_RUNS else "NO_RUNS",
     threads: MPM_THREADS
-    # the longest runs first (their counted particle-steps, in thousands): with several runs at once
-    # (--cores over mpm.threads) a long run started last would finish alone while the other cores idle
-    priority: lambda wc: int(MPM_COST[wc.run].particle_steps // 1e3)
+    priority: lambda wc: MPM_PRIORITY[wc.run]  # the longest first (common.smk)
     resources:
         mem_mb=lambda wc: MPM_COST[wc.run].memory_mb,
         runtime=lambda wc, threads: cost.runtime_minutes(MPM_COST[wc.run], threads),
@@ -60,6 +58,7 @@ checkpoint mpm_refine:
         solver=SOLVER_FINGERPRINT,
     wildcard_constraints:
         run="|".join(re.escape(r) for r in SKIPPABLE) if SKIPPABLE else "NO_RUNS",
+    priority: DECISION_PRIORITY  # before any run (common.smk)
     log:
         "logs/refinement/{run}.log",
     conda:

@@ -14,10 +14,12 @@ a job's start-up, its result's writing and the fixed cost of a step are in it. T
   ``benchmark:``, column ``s``) beside a result file that is a run (not a skip or failure marker), its
   threads read from the result (``cost_threads``); and
 * the rows of ``benchmarks/results/projection_check_*.json`` (``benchmarks/projection_check.py``: workflow
-  runs measured here, at the threads of the config each names), where no benchmark file of the same run
-  is present.
+  runs measured here, at the threads each row or file records, 2 where neither says), where no benchmark
+  file of the same run is present.
 
-Jobs measured at other thread counts are scaled linearly (optimistic: the scaling is not linear). With no
+Jobs measured at other thread counts are scaled linearly: optimistic for more threads a run (a run gains
+1.6-1.8x from a second thread here), pessimistic for fewer (two one-thread runs at once beat one two-thread
+run by 1.1-1.3x: docs/performance.md, "Two runs at once"). With no
 measured job of a family, its runs go at :data:`plough.study.cost.THROUGHPUT_PER_THREAD` a thread, the
 slowest rate measured for workflow jobs here. On a cluster each run is one job with the profile's threads
 (``set-threads: mpm_run``), its time scaled linearly from the time here, and its request the profile's
