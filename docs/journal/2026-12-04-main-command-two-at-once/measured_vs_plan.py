@@ -29,5 +29,6 @@ tot_p = sum(r[5] for r in rows if not r[7])
 print(f"plan threads {plan.threads}; {len(rows)} jobs")
 print("| run | family | h | particle-steps | measured s | projected s (1 thread, linear) | ratio | threads |")
 for r in rows:
-    print(f"| {r[0]} | {r[1]} | {r[2]:g} | {r[3]:.3g} | {r[4]:.0f} | {r[5]:.0f} | {r[4] / r[5]:.2f} | {r[6]}{' marker' if r[7] else ''} |")
+    marker = " marker" if r[7] else ""
+    print(f"| {r[0]} | {r[1]} | {r[2]:g} | {r[3]:.3g} | {r[4]:.0f} | {r[5]:.0f} | {r[4] / r[5]:.2f} | {r[6]}{marker} |")
 print(f"total measured {tot_m:.0f} s, projected {tot_p:.0f} s: {tot_m / tot_p:.2f}")
