@@ -34,22 +34,12 @@ def measured_seconds(tsv: Path) -> float:
         return float(next(csv.DictReader(f, delimiter="\t"))["s"])
 
 
-def simulate_seconds(result: Path) -> float:
-    """The run's own wall time (``cost_wall_time_s``: press and slide, without the job's start-up and the
-    result's writing), NaN for a marker or a missing file."""
+def result_attrs(result: Path) -> dict:
+    """The result file's attributes ({} for a missing file)."""
     if not result.exists():
-        return float("nan")
+        return {}
     with xr.open_dataset(result) as ds:
-        return float(ds.attrs.get("cost_wall_time_s", float("nan")))
-
-
-def run_threads(result: Path, default: int) -> int:
-    """The threads the run ran at (``cost_threads`` of its result), ``default`` (the config's) for a marker or a
-    missing file."""
-    if not result.exists():
-        return default
-    with xr.open_dataset(result) as ds:
-        return int(ds.attrs.get("cost_threads", default))
+        return dict(ds.attrs)
 
 
 def main() -> None:
@@ -68,6 +58,7 @@ def main() -> None:
         if not tsv.exists():
             continue
         scene = Scene.from_dict(scene_dict)
+        attrs = result_attrs(result)
         c, real, projected = project_run(scene, throughput, material_factor)
         lay = scene.layers
         system = ("rigid-plastic" if not real else lay.substrate.name if lay.coating is None
@@ -76,8 +67,11 @@ def main() -> None:
                      "family": "real materials" if real else "rigid-plastic", "system": system,
                      "particles": c.particles,
                      "particle_steps": c.particle_steps, "projected_s": projected,
-                     "measured_s": measured_seconds(tsv), "simulate_s": simulate_seconds(result),
-                     "threads": run_threads(result, int(config["mpm"]["threads"]))})
+                     "measured_s": measured_seconds(tsv),
+                     # the run's own wall time (press and slide, without the job's start-up and writing), NaN
+                     # for a marker or a missing file; the threads it ran at, the config's for those
+                     "simulate_s": float(attrs.get("cost_wall_time_s", math.nan)),
+                     "threads": int(attrs.get("cost_threads", config["mpm"]["threads"]))})
     if not rows:
         raise SystemExit(f"no benchmark file of this config's runs under {args.workdir / 'benchmarks' / 'runs'}")
     print(f"{len(rows)} of {len(matrix.all_runs(config))} runs measured\n")

@@ -9,18 +9,26 @@ from pathlib import Path
 
 import pytest
 import xarray as xr
+import yaml
+
+from plough.mpm.scene import Scene
+from plough.study import cost, matrix
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-@pytest.fixture(scope="module")
-def workdir(tmp_path_factory):
-    d = tmp_path_factory.mktemp("wf")
+def _copy_workflow(d: Path) -> Path:
+    """The workflow (Snakefile, config, rules) copied into ``d``, the package's source linked beside it."""
     for name in ("Snakefile", "config", "workflow"):
         src = ROOT / name
         (shutil.copytree if src.is_dir() else shutil.copy)(src, d / name)
     (d / "src").symlink_to(ROOT / "src")
     return d
+
+
+@pytest.fixture(scope="module")
+def workdir(tmp_path_factory):
+    return _copy_workflow(tmp_path_factory.mktemp("wf"))
 
 
 def _snakemake(workdir, *args):
@@ -142,12 +150,6 @@ def test_refinement_checkpoint_decides_then_asks_only_for_the_needed_finest_runs
 def test_the_longest_runs_start_first(workdir):
     """Each MPM run's priority is its counted particle-steps (in thousands), so that with several runs at once
     (--cores over mpm.threads) the scheduler starts the longest first and none is left to finish alone."""
-    import yaml
-
-    sys.path.insert(0, str(ROOT / "src"))
-    from plough.mpm.scene import Scene
-    from plough.study import cost, matrix
-
     config = yaml.safe_load((workdir / "config/smoke.yaml").read_text())
     runs = matrix.all_runs(config)
     out = _snakemake(workdir, "--configfile=config/smoke.yaml", "-n", "--forceall", "results/datasets/fig15.nc")
@@ -166,22 +168,13 @@ def test_the_longest_runs_start_first(workdir):
 def test_refinement_decisions_go_before_any_run(tmp_path):
     """The default config's refinement decisions (seconds each) have a priority above every run's, so that the
     finest runs they let in (the longest of all) join the queue as soon as their coarser runs are made."""
-    for name in ("Snakefile", "config", "workflow"):
-        src = ROOT / name
-        (shutil.copytree if src.is_dir() else shutil.copy)(src, tmp_path / name)
-    (tmp_path / "src").symlink_to(ROOT / "src")
-    out = _snakemake(tmp_path, "-n")
+    out = _snakemake(_copy_workflow(tmp_path), "-n")
     assert out.returncode == 0, out.stderr[-3000:]
     priorities: dict[str, list[int]] = {}
     for block in re.split(r"\n(?:rule|checkpoint) ", out.stdout + out.stderr)[1:]:
         rule = block.split(":")[0]
         if rule in ("mpm_run", "mpm_refine"):
             priorities.setdefault(rule, []).append(int(block.split("priority: ")[1].split()[0]))
-    import yaml
-
-    sys.path.insert(0, str(ROOT / "src"))
-    from plough.study import matrix
-
     gated = matrix.skippable_runs(yaml.safe_load((ROOT / "config" / "config.yaml").read_text()))
     assert len(priorities["mpm_refine"]) == len(gated) > 0 and len(set(priorities["mpm_refine"])) == 1
     assert priorities["mpm_refine"][0] > max(priorities["mpm_run"])
