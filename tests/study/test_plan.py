@@ -65,6 +65,18 @@ def test_rates_per_family_at_the_nearest_measured_size():
     assert only_rp.rate("real materials", 5) == pytest.approx(cost.THROUGHPUT_PER_THREAD * 2)
 
 
+def test_jobs_at_the_configs_threads_set_the_rate_where_measured():
+    """A second thread is not linear (1.6-1.8x here): where a size was measured at the config's threads, jobs
+    measured at other threads do not dilute its rate; elsewhere they are scaled linearly and said to be."""
+    rows = [_row("a", "real materials", 5, 1e9, 1000, threads=1), _row("b", "real materials", 5, 4e9, 1000),
+            _row("c", "real materials", 10, 1e9, 100, threads=2), _row("d", "real materials", 10, 1e9, 100, threads=4)]
+    rates = Rates.from_measured(rows, threads=1)
+    assert rates.rate("real materials", 5) == pytest.approx(1e9 / 1000)  # b (2 threads) left out
+    assert rates.by_family["real materials"][5][0] == 1
+    assert rates.rate("real materials", 10) == pytest.approx(2e9 / 600)  # 200 + 400 s scaled to one thread
+    assert rates.scaled == {("real materials", 10)}
+
+
 def _calibration(tmp_path: Path, rows: list[dict]) -> Path:
     path = tmp_path / "projection_check_test.json"
     path.write_text(json.dumps({"config": "none.yaml", "runs": rows}))

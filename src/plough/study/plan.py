@@ -17,9 +17,10 @@ a job's start-up, its result's writing and the fixed cost of a step are in it. T
   runs measured here, at the threads each row or file records, 2 where neither says), where no benchmark
   file of the same run is present.
 
-Jobs measured at other thread counts are scaled linearly: optimistic for more threads a run (a run gains
-1.6-1.8x from a second thread here), pessimistic for fewer (two one-thread runs at once beat one two-thread
-run by 1.1-1.3x: docs/performance.md, "Two runs at once"). With no
+Where jobs of a family and size were measured at the config's threads, only they set its rate. Elsewhere jobs
+measured at other thread counts are scaled linearly: optimistic for more threads a run (a run gains 1.6-1.8x
+from a second thread here), pessimistic for fewer (two one-thread runs at once beat one two-thread run by
+1.1-1.3x: docs/performance.md, "Two runs at once"). With no
 measured job of a family, its runs go at :data:`plough.study.cost.THROUGHPUT_PER_THREAD` a thread, the
 slowest rate measured for workflow jobs here. On a cluster each run is one job with the profile's threads
 (``set-threads: mpm_run``), its time scaled linearly from the time here, and its request the profile's
@@ -155,20 +156,29 @@ class Rates:
 
     threads: int
     by_family: dict[str, dict[float, tuple[int, float]]]  # family -> h (um) -> (jobs, particle-steps / s)
+    #: the (family, h) whose rate is scaled from jobs measured at other threads (none measured at ``threads``)
+    scaled: frozenset[tuple[str, float]] = frozenset()
 
     @classmethod
     def from_measured(cls, rows: Iterable[Measured], threads: int) -> Rates:
-        """Sum of particle-steps over the sum of wall times (each scaled linearly to ``threads``) per family and
-        size; a run measured twice counts once, its last row."""
+        """Sum of particle-steps over the sum of wall times per family and size; a run measured twice counts once,
+        its last row. Where jobs of a family and size were measured at ``threads``, only they count: a rate
+        scaled from other threads is linear in them, which a second thread is not (it gains 1.6-1.8x here).
+        Elsewhere every job counts, its wall time scaled linearly to ``threads``."""
         last = {r.run: r for r in rows}
-        sums: dict[str, dict[float, list[float]]] = {}
+        groups: dict[tuple[str, float], list[Measured]] = {}
         for r in last.values():
-            acc = sums.setdefault(r.family, {}).setdefault(r.h_um, [0, 0.0, 0.0])
-            acc[0] += 1
-            acc[1] += r.particle_steps
-            acc[2] += r.seconds * r.threads / threads
-        return cls(threads, {fam: {h: (int(a[0]), a[1] / a[2]) for h, a in by_h.items()}
-                             for fam, by_h in sums.items()})
+            groups.setdefault((r.family, r.h_um), []).append(r)
+        by_family: dict[str, dict[float, tuple[int, float]]] = {}
+        scaled = set()
+        for (family, h), group in groups.items():
+            same = [r for r in group if r.threads == threads]
+            if not same:
+                scaled.add((family, h))
+            used = same or group
+            seconds = sum(r.seconds * r.threads / threads for r in used)
+            by_family.setdefault(family, {})[h] = (len(used), sum(r.particle_steps for r in used) / seconds)
+        return cls(threads, by_family, frozenset(scaled))
 
     def rate(self, family: str, h_um: float) -> float:
         """The family's rate at the measured size nearest in log h (the smaller of two as near, as
@@ -316,12 +326,12 @@ def describe(plan: Plan, *, points: bool = False) -> str:
         else:
             text = f"none measured: {plan.rates.rate(fam, 1.0) / 1e6:.2f} M/s (plough.study.cost.THROUGHPUT_PER_THREAD)"
         lines.append(f"  {fam}, particle-steps per second of a job at {_threads(plan.threads)}: {text}")
-    other = sorted({r.threads for r in plan.measured} - {plan.threads})
-    if other:
+    if plan.rates.scaled:
         # linear in the threads: conservative for fewer threads a run (two one-thread runs at once measured 1.31x
         # the throughput of one two-thread run here: docs/performance.md, "Two runs at once")
-        lines.append(f"  (jobs measured at {', '.join(map(str, other))} threads scaled linearly to "
-                     f"{_threads(plan.threads)} a run)")
+        where = "; ".join(f"{fam} h = {h:g} um" for fam, h in sorted(plan.rates.scaled))
+        lines.append(f"  (measured at other threads and scaled linearly to {_threads(plan.threads)} a run, none "
+                     f"measured at {_threads(plan.threads)}: {where})")
     lines.append("")
     lines.append(f"| figure | MPM runs | particle-steps | here (--cores {plan.cores}, {_threads(plan.threads)} "
                  f"a run) | longest job here | longest job on the cluster ({plan.cluster_threads} threads) |")
