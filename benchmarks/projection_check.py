@@ -26,6 +26,7 @@ from reproduction_time import ROOT, add_measured_arguments, project_run, through
 
 from plough.mpm.scene import Scene
 from plough.study import matrix
+from plough.study.skipping import FAILED_ATTR, SKIPPED_ATTR
 
 
 def measured_seconds(tsv: Path) -> float:
@@ -59,6 +60,8 @@ def main() -> None:
             continue
         scene = Scene.from_dict(scene_dict)
         attrs = result_attrs(result)
+        if attrs.get(FAILED_ATTR) or attrs.get(SKIPPED_ATTR):
+            continue  # a marker's job made no run: its seconds are not its particle-steps' time
         c, real, projected = project_run(scene, throughput, material_factor)
         lay = scene.layers
         system = ("rigid-plastic" if not real else lay.substrate.name if lay.coating is None
@@ -69,7 +72,7 @@ def main() -> None:
                      "particle_steps": c.particle_steps, "projected_s": projected,
                      "measured_s": measured_seconds(tsv),
                      # the run's own wall time (press and slide, without the job's start-up and writing), NaN
-                     # for a marker or a missing file; the threads it ran at, the config's for those
+                     # for a missing file; the threads it ran at, the config's for that
                      "simulate_s": float(attrs.get("cost_wall_time_s", math.nan)),
                      "threads": int(attrs.get("cost_threads", config["mpm"]["threads"]))})
     if not rows:

@@ -139,6 +139,30 @@ def test_benchmark_files_of_the_configs_runs_calibrate_markers_do_not(tmp_path):
     assert rows[0].particle_steps == cost.estimate(runs[made]).particle_steps
 
 
+def test_projection_check_rows_are_runs_not_markers(tmp_path):
+    """benchmarks/projection_check.py writes the calibration rows plough plan reads: a failure marker's job made
+    no run, and its seconds over the run's counted particle-steps would be a rate it never had."""
+    import subprocess
+    import sys
+
+    runs = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(SMOKE).items()}
+    made, marker = sorted(runs)[:2]
+    (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
+    (tmp_path / "results" / "runs").mkdir(parents=True)
+    for rid, seconds in ((made, 12.5), (marker, 0.4)):
+        (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
+    xr.Dataset(attrs={"cost_wall_time_s": 11.0, "cost_threads": 1}).to_netcdf(
+        tmp_path / "results" / "runs" / f"{made}.nc")
+    xr.Dataset(attrs={"failed_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
+    out = tmp_path / "projection_check_test.json"
+    subprocess.run([sys.executable, str(ROOT / "benchmarks" / "projection_check.py"), "--workdir", str(tmp_path),
+                    "--config", str(ROOT / "config" / "smoke.yaml"), "--out", str(out)],
+                   check=True, capture_output=True, cwd=ROOT)
+    rows = measured_from_json([out])
+    assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 1)]
+    assert rows[0].particle_steps == pytest.approx(cost.estimate(runs[made]).particle_steps)
+
+
 def test_the_plan_states_the_range_refinement_only_where_needed_leaves(tmp_path):
     """Gated finest runs (mpm.skip_finest_tolerance) are made only where their decision asks: the plan counts each
     decision made (results/refinement/<run>.json) as it says, and an undecided one at both ends of a range."""

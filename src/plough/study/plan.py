@@ -127,6 +127,7 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
     import xarray as xr
 
     from plough.study import cost
+    from plough.study.skipping import FAILED_ATTR, SKIPPED_ATTR
 
     rows = []
     for tsv in sorted((directory / RUN_BENCHMARKS).glob("*.tsv")):
@@ -139,7 +140,7 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
                 attrs = dict(ds.attrs)
         except (OSError, ValueError):
             continue
-        if attrs.get("skipped_finest_size") or attrs.get("failed_finest_size") or "cost_particle_steps" not in attrs:
+        if attrs.get(SKIPPED_ATTR) or attrs.get(FAILED_ATTR) or "cost_particle_steps" not in attrs:
             continue
         with tsv.open() as f:
             seconds = float(next(csv.DictReader(f, delimiter="\t"))["s"])
