@@ -3,7 +3,8 @@
     python benchmarks/projection_check.py --workdir DIR [--config config/preview.yaml] [--out FILE]
 
 ``DIR`` is the directory a ``snakemake --cores 2 --configfile=CONFIG`` ran in. For every MPM run of the
-config whose per-run benchmark file ``DIR/benchmarks/runs/<run>.tsv`` exists (Snakemake's ``benchmark:``,
+config whose per-run benchmark file ``DIR/benchmarks/runs/<run>.tsv`` exists and whose result is a run (not a
+failure or skip marker) (Snakemake's ``benchmark:``,
 column ``s``: the job's wall time, numba's start-up included), the projection of
 ``benchmarks/reproduction_time.py`` (particle-steps from ``plough.study.cost`` over the measured
 throughput, with the graded, active-zone and real-material factors) is set beside it. Prints the

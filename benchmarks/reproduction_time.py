@@ -47,7 +47,7 @@ import yaml
 from plough.materials import ConstantFlow
 from plough.mpm.scene import Scene
 from plough.study import cost, matrix
-from plough.study.plan import measured_from_json
+from plough.study.plan import calibrating, measured_from_json
 
 ROOT = Path(__file__).resolve().parents[1]
 
@@ -118,18 +118,19 @@ def throughput_model(config: dict, args: argparse.Namespace) -> tuple[float, flo
 def calibration_ratios(paths: list[str], throughput: float, material_factor: float
                        ) -> dict[str, dict[float, tuple[int, float]]]:
     """family -> h (um) -> (runs, sum of measured job seconds / sum of projected seconds) over the
-    ``projection_check.py`` files' rows, read as ``plough plan`` reads them (``plough.study.plan.
-    measured_from_json``: each at the threads it records); a run in several files counts once, its last
-    measurement; a job measured at other threads than the projection's 2 is scaled linearly to 2."""
-    rows = {m.run: m for path in paths for m in measured_from_json([Path(path)])}
-    sums: dict[str, dict[float, list[float]]] = {}
-    for r in rows.values():
-        rate = throughput * (material_factor if r.family == "real materials" else 1.0)
-        acc = sums.setdefault(r.family, {}).setdefault(r.h_um, [0, 0.0, 0.0])
-        acc[0] += 1
-        acc[1] += r.seconds * r.threads / 2
-        acc[2] += r.particle_steps / rate
-    return {fam: {h: (int(a[0]), a[1] / a[2]) for h, a in by_h.items()} for fam, by_h in sums.items()}
+    ``projection_check.py`` files' rows, read and picked as ``plough plan`` picks them (``plough.study.plan.
+    measured_from_json`` and ``calibrating``: each at the threads it records, a run once, its last measurement,
+    only the jobs at the projection's 2 threads where a size has them); a job at other threads is scaled
+    linearly to 2."""
+    rows = [m for path in paths for m in measured_from_json([Path(path)])]
+    groups, _ = calibrating(rows, 2)
+    out: dict[str, dict[float, tuple[int, float]]] = {}
+    for (family, h), used in groups.items():
+        rate = throughput * (material_factor if family == "real materials" else 1.0)
+        measured = sum(r.seconds * r.threads / 2 for r in used)
+        projected = sum(r.particle_steps / rate for r in used)
+        out.setdefault(family, {})[h] = (len(used), measured / projected)
+    return out
 
 
 def calibration_for(ratios: dict[str, dict[float, tuple[int, float]]], family: str, h_um: float) -> float:

@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import copy
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -69,12 +71,14 @@ def test_jobs_at_the_configs_threads_set_the_rate_where_measured():
     """A second thread is not linear (1.6-1.8x here): where a size was measured at the config's threads, jobs
     measured at other threads do not dilute its rate; elsewhere they are scaled linearly and said to be."""
     rows = [_row("a", "real materials", 5, 1e9, 1000, threads=1), _row("b", "real materials", 5, 4e9, 1000),
-            _row("c", "real materials", 10, 1e9, 100, threads=2), _row("d", "real materials", 10, 1e9, 100, threads=4)]
+            _row("c", "real materials", 10, 1e9, 100, threads=2), _row("d", "real materials", 10, 1e9, 100, threads=4),
+            _row("e", "real materials", 20, 1e9, 100, threads=1), _row("e", "real materials", 20, 1e9, 300)]
     rates = Rates.from_measured(rows, threads=1)
+    assert rates.rate("real materials", 20) == pytest.approx(1e9 / 600)  # e's last row (2 threads) counts
     assert rates.rate("real materials", 5) == pytest.approx(1e9 / 1000)  # b (2 threads) left out
     assert rates.by_family["real materials"][5][0] == 1
     assert rates.rate("real materials", 10) == pytest.approx(2e9 / 600)  # 200 + 400 s scaled to one thread
-    assert rates.scaled == {("real materials", 10)}
+    assert rates.scaled == {("real materials", 10), ("real materials", 20)}
 
 
 def _calibration(tmp_path: Path, rows: list[dict]) -> Path:
@@ -141,17 +145,15 @@ def test_benchmark_files_of_the_configs_runs_calibrate_markers_do_not(tmp_path):
 
 def test_projection_check_rows_are_runs_not_markers(tmp_path):
     """benchmarks/projection_check.py writes the calibration rows plough plan reads: a failure marker's job made
-    no run, and its seconds over the run's counted particle-steps would be a rate it never had."""
-    import subprocess
-    import sys
-
+    no run, and its seconds over the run's counted particle-steps would be a rate it never had. A row's threads
+    are those its result records, not the config's (smoke: 1)."""
     runs = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(SMOKE).items()}
     made, marker = sorted(runs)[:2]
     (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
     (tmp_path / "results" / "runs").mkdir(parents=True)
     for rid, seconds in ((made, 12.5), (marker, 0.4)):
         (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
-    xr.Dataset(attrs={"cost_wall_time_s": 11.0, "cost_threads": 1}).to_netcdf(
+    xr.Dataset(attrs={"cost_wall_time_s": 11.0, "cost_threads": 2}).to_netcdf(
         tmp_path / "results" / "runs" / f"{made}.nc")
     xr.Dataset(attrs={"failed_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
     out = tmp_path / "projection_check_test.json"
@@ -159,7 +161,7 @@ def test_projection_check_rows_are_runs_not_markers(tmp_path):
                     "--config", str(ROOT / "config" / "smoke.yaml"), "--out", str(out)],
                    check=True, capture_output=True, cwd=ROOT)
     rows = measured_from_json([out])
-    assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 1)]
+    assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 2)]
     assert rows[0].particle_steps == pytest.approx(cost.estimate(runs[made]).particle_steps)
 
 

@@ -144,11 +144,33 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
             continue
         with tsv.open() as f:
             seconds = float(next(csv.DictReader(f, delimiter="\t"))["s"])
+        if not (math.isfinite(seconds) and seconds > 0):
+            continue
         scene = runs[rid]
         rows.append(Measured(rid, family_of(scene), round(scene.discretisation.particle_size_m * 1e6, 6),
                              cost.estimate(scene).particle_steps, seconds, int(attrs.get("cost_threads", threads)),
                              str(tsv)))
     return rows
+
+
+def calibrating(rows: Iterable[Measured], threads: int
+                ) -> tuple[dict[tuple[str, float], list[Measured]], frozenset[tuple[str, float]]]:
+    """The jobs that calibrate each (family, h) for runs at ``threads``, and the (family, h) with none measured at
+    ``threads``. A run measured twice counts once, its last row. Where jobs of a family and size ran at
+    ``threads``, only they count: scaling from other threads is linear in them, which a second thread is not
+    (it gains 1.6-1.8x here). Elsewhere every job counts, to be scaled linearly."""
+    last = {r.run: r for r in rows}
+    groups: dict[tuple[str, float], list[Measured]] = {}
+    for r in last.values():
+        groups.setdefault((r.family, r.h_um), []).append(r)
+    scaled: set[tuple[str, float]] = set()
+    for key, group in groups.items():
+        same = [r for r in group if r.threads == threads]
+        if same:
+            groups[key] = same
+        else:
+            scaled.add(key)
+    return groups, frozenset(scaled)
 
 
 @dataclass(frozen=True)
@@ -162,24 +184,14 @@ class Rates:
 
     @classmethod
     def from_measured(cls, rows: Iterable[Measured], threads: int) -> Rates:
-        """Sum of particle-steps over the sum of wall times per family and size; a run measured twice counts once,
-        its last row. Where jobs of a family and size were measured at ``threads``, only they count: a rate
-        scaled from other threads is linear in them, which a second thread is not (it gains 1.6-1.8x here).
-        Elsewhere every job counts, its wall time scaled linearly to ``threads``."""
-        last = {r.run: r for r in rows}
-        groups: dict[tuple[str, float], list[Measured]] = {}
-        for r in last.values():
-            groups.setdefault((r.family, r.h_um), []).append(r)
+        """Sum of particle-steps over the sum of wall times per family and size, each wall time scaled linearly
+        to ``threads``, over the jobs :func:`calibrating` picks."""
+        groups, scaled = calibrating(rows, threads)
         by_family: dict[str, dict[float, tuple[int, float]]] = {}
-        scaled = set()
-        for (family, h), group in groups.items():
-            same = [r for r in group if r.threads == threads]
-            if not same:
-                scaled.add((family, h))
-            used = same or group
+        for (family, h), used in groups.items():
             seconds = sum(r.seconds * r.threads / threads for r in used)
             by_family.setdefault(family, {})[h] = (len(used), sum(r.particle_steps for r in used) / seconds)
-        return cls(threads, by_family, frozenset(scaled))
+        return cls(threads, by_family, scaled)
 
     def rate(self, family: str, h_um: float) -> float:
         """The family's rate at the measured size nearest in log h (the smaller of two as near, as
@@ -318,8 +330,12 @@ def describe(plan: Plan, *, points: bool = False) -> str:
     else:
         lines.append(f"ladder: paper ({sizes} um for every point)")
     sources = sorted({r.source for r in plan.measured})
-    lines.append(f"calibration: {len({r.run for r in plan.measured})} measured workflow jobs"
-                 + (f" ({'; '.join(_short(s) for s in _sources(sources))})" if sources else ""))
+    used = sum(n for by_h in plan.rates.by_family.values() for n, _ in by_h.values())
+    left_out = len({r.run for r in plan.measured}) - used
+    lines.append(f"calibration: {used} measured workflow jobs"
+                 + (f" ({'; '.join(_short(s) for s in _sources(sources))})" if sources else "")
+                 + (f"; {left_out} more at other threads left out where jobs at {_threads(plan.threads)} were "
+                    "measured" if left_out else ""))
     for fam in FAMILIES:
         by_h = plan.rates.by_family.get(fam)
         if by_h:
@@ -331,8 +347,8 @@ def describe(plan: Plan, *, points: bool = False) -> str:
         # linear in the threads: conservative for fewer threads a run (two one-thread runs at once measured 1.31x
         # the throughput of one two-thread run here: docs/performance.md, "Two runs at once")
         where = "; ".join(f"{fam} h = {h:g} um" for fam, h in sorted(plan.rates.scaled))
-        lines.append(f"  (measured at other threads and scaled linearly to {_threads(plan.threads)} a run, none "
-                     f"measured at {_threads(plan.threads)}: {where})")
+        lines.append(f"  (scaled linearly to {_threads(plan.threads)} a run from jobs at other threads, no job at "
+                     f"{_threads(plan.threads)} there: {where})")
     lines.append("")
     lines.append(f"| figure | MPM runs | particle-steps | here (--cores {plan.cores}, {_threads(plan.threads)} "
                  f"a run) | longest job here | longest job on the cluster ({plan.cluster_threads} threads) |")
