@@ -119,9 +119,9 @@ def calibration_ratios(paths: list[str], throughput: float, material_factor: flo
                        ) -> dict[str, dict[float, tuple[int, float]]]:
     """family -> h (um) -> (runs, sum of measured job seconds / sum of projected seconds) over the
     ``projection_check.py`` files' rows, read and picked as ``plough plan`` picks them (``plough.study.plan.
-    measured_from_json`` and ``calibrating``: each at the threads it records, a run once, its last measurement,
-    only the jobs at the projection's 2 threads where a size has them); a job at other threads is scaled
-    linearly to 2."""
+    measured_from_json`` and ``calibrating``: each at the threads it records, a run once, its last measurement
+    at 2 threads else its last, only the jobs at the projection's 2 threads where a size has them); a job at
+    other threads is scaled linearly to 2."""
     rows = [m for path in paths for m in measured_from_json([Path(path)])]
     groups, _ = calibrating(rows, 2)
     out: dict[str, dict[float, tuple[int, float]]] = {}

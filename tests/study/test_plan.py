@@ -72,13 +72,15 @@ def test_jobs_at_the_configs_threads_set_the_rate_where_measured():
     measured at other threads do not dilute its rate; elsewhere they are scaled linearly and said to be."""
     rows = [_row("a", "real materials", 5, 1e9, 1000, threads=1), _row("b", "real materials", 5, 4e9, 1000),
             _row("c", "real materials", 10, 1e9, 100, threads=2), _row("d", "real materials", 10, 1e9, 100, threads=4),
-            _row("e", "real materials", 20, 1e9, 100, threads=1), _row("e", "real materials", 20, 1e9, 300)]
+            _row("e", "real materials", 20, 1e9, 100, threads=1), _row("e", "real materials", 20, 1e9, 300),
+            _row("f", "real materials", 40, 1e9, 100), _row("f", "real materials", 40, 1e9, 400, threads=4)]
     rates = Rates.from_measured(rows, threads=1)
-    assert rates.rate("real materials", 20) == pytest.approx(1e9 / 600)  # e's last row (2 threads) counts
+    assert rates.rate("real materials", 20) == pytest.approx(1e9 / 100)  # e at 1 thread, though measured again at 2
+    assert rates.rate("real materials", 40) == pytest.approx(1e9 / 1600)  # f's last row, 4 threads scaled to 1
     assert rates.rate("real materials", 5) == pytest.approx(1e9 / 1000)  # b (2 threads) left out
     assert rates.by_family["real materials"][5][0] == 1
     assert rates.rate("real materials", 10) == pytest.approx(2e9 / 600)  # 200 + 400 s scaled to one thread
-    assert rates.scaled == {("real materials", 10), ("real materials", 20)}
+    assert rates.scaled == {("real materials", 10), ("real materials", 40)}
 
 
 def _calibration(tmp_path: Path, rows: list[dict]) -> Path:

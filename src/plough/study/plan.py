@@ -156,10 +156,14 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
 def calibrating(rows: Iterable[Measured], threads: int
                 ) -> tuple[dict[tuple[str, float], list[Measured]], frozenset[tuple[str, float]]]:
     """The jobs that calibrate each (family, h) for runs at ``threads``, and the (family, h) with none measured at
-    ``threads``. A run measured twice counts once, its last row. Where jobs of a family and size ran at
-    ``threads``, only they count: scaling from other threads is linear in them, which a second thread is not
-    (it gains 1.6-1.8x here). Elsewhere every job counts, to be scaled linearly."""
-    last = {r.run: r for r in rows}
+    ``threads``. Scaling from other threads is linear in them, which a second thread is not (it gains 1.6-1.8x
+    here), so jobs at ``threads`` go first: a run measured more than once counts once, its last row at
+    ``threads``, else its last row; where jobs of a family and size ran at ``threads``, only they count.
+    Elsewhere every job counts, to be scaled linearly."""
+    last: dict[str, Measured] = {}
+    for r in rows:
+        if r.threads == threads or r.run not in last or last[r.run].threads != threads:
+            last[r.run] = r
     groups: dict[tuple[str, float], list[Measured]] = {}
     for r in last.values():
         groups.setdefault((r.family, r.h_um), []).append(r)
