@@ -3,9 +3,9 @@
     python benchmarks/projection_check.py --workdir DIR [--config config/preview.yaml] [--out FILE]
 
 ``DIR`` is the directory a ``snakemake --cores 2 --configfile=CONFIG`` ran in. For every MPM run of the
-config whose per-run benchmark file ``DIR/benchmarks/runs/<run>.tsv`` exists and whose result is a run (not a
-failure or skip marker) (Snakemake's ``benchmark:``,
-column ``s``: the job's wall time, numba's start-up included), the projection of
+config whose per-run benchmark file ``DIR/benchmarks/runs/<run>.tsv`` exists (Snakemake's ``benchmark:``,
+column ``s``: the job's wall time, numba's start-up included) and whose result is a run, not a failure or
+skip marker, the projection of
 ``benchmarks/reproduction_time.py`` (particle-steps from ``plough.study.cost`` over the measured
 throughput, with the graded, active-zone and real-material factors) is set beside it. Prints the
 totals and the ratio measured / projected by particle size, family and material system (median, range). Writes the
@@ -15,7 +15,6 @@ per-run rows to ``--out`` (default benchmarks/results/projection_check.json).
 from __future__ import annotations
 
 import argparse
-import csv
 import json
 import math
 import statistics
@@ -27,13 +26,7 @@ from reproduction_time import ROOT, add_measured_arguments, project_run, through
 
 from plough.mpm.scene import Scene
 from plough.study import matrix
-from plough.study.skipping import FAILED_ATTR, SKIPPED_ATTR
-
-
-def measured_seconds(tsv: Path) -> float:
-    """The wall time in seconds of a Snakemake benchmark file (its first row, column ``s``)."""
-    with tsv.open() as f:
-        return float(next(csv.DictReader(f, delimiter="\t"))["s"])
+from plough.study.plan import is_marker, job_seconds
 
 
 def result_attrs(result: Path) -> dict:
@@ -61,7 +54,7 @@ def main() -> None:
             continue
         scene = Scene.from_dict(scene_dict)
         attrs = result_attrs(result)
-        if attrs.get(FAILED_ATTR) or attrs.get(SKIPPED_ATTR):
+        if is_marker(attrs):
             continue  # a marker's job made no run: its seconds are not its particle-steps' time
         c, real, projected = project_run(scene, throughput, material_factor)
         lay = scene.layers
@@ -71,7 +64,7 @@ def main() -> None:
                      "family": "real materials" if real else "rigid-plastic", "system": system,
                      "particles": c.particles,
                      "particle_steps": c.particle_steps, "projected_s": projected,
-                     "measured_s": measured_seconds(tsv),
+                     "measured_s": job_seconds(tsv),
                      # the run's own wall time (press and slide, without the job's start-up and writing), NaN
                      # for a missing file; the threads it ran at, the config's for that
                      "simulate_s": float(attrs.get("cost_wall_time_s", math.nan)),

@@ -120,6 +120,19 @@ def measured_from_json(paths: Iterable[Path]) -> list[Measured]:
     return rows
 
 
+def job_seconds(tsv: Path) -> float:
+    """The wall time in seconds of a Snakemake benchmark file (its first row, column ``s``)."""
+    with tsv.open() as f:
+        return float(next(csv.DictReader(f, delimiter="\t"))["s"])
+
+
+def is_marker(attrs: Mapping[str, Any]) -> bool:
+    """Whether a result's attributes are a failure or skip marker's: its job made no run to calibrate with."""
+    from plough.study.skipping import FAILED_ATTR, SKIPPED_ATTR
+
+    return bool(attrs.get(FAILED_ATTR) or attrs.get(SKIPPED_ATTR))
+
+
 def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: int) -> list[Measured]:
     """The workflow's benchmark files of ``runs`` (run id -> scene) under ``directory``: each with a result
     file that is a run; a skip or failure marker's job made no run. Threads from the result
@@ -127,7 +140,6 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
     import xarray as xr
 
     from plough.study import cost
-    from plough.study.skipping import FAILED_ATTR, SKIPPED_ATTR
 
     rows = []
     for tsv in sorted((directory / RUN_BENCHMARKS).glob("*.tsv")):
@@ -140,10 +152,9 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
                 attrs = dict(ds.attrs)
         except (OSError, ValueError):
             continue
-        if attrs.get(SKIPPED_ATTR) or attrs.get(FAILED_ATTR) or "cost_particle_steps" not in attrs:
+        if is_marker(attrs) or "cost_particle_steps" not in attrs:
             continue
-        with tsv.open() as f:
-            seconds = float(next(csv.DictReader(f, delimiter="\t"))["s"])
+        seconds = job_seconds(tsv)
         if not (math.isfinite(seconds) and seconds > 0):
             continue
         scene = runs[rid]
