@@ -3,6 +3,10 @@ projection calibrated as on a fresh clone before this part (the two committed pr
 two-thread jobs scaled linearly to the run's threads).
 
     PYTHONPATH=src python part_vs_plan.py RUN_DIR REPO --since 2026-12-05T00:54:40 [--until ...]
+        [--calibration FILE ...]
+
+--calibration: other projection_check files to calibrate with (the third part's: REPO's committed
+benchmarks/results/projection_check_*.json at cb680ae).
 """
 import argparse
 import csv
@@ -18,11 +22,12 @@ p.add_argument("run_dir", type=Path)
 p.add_argument("repo", type=Path)
 p.add_argument("--since", required=True)
 p.add_argument("--until", default="2100-01-01T00:00:00")
+p.add_argument("--calibration", nargs="+", type=Path)
 a = p.parse_args()
 since = dt.datetime.fromisoformat(a.since).replace(tzinfo=dt.UTC).timestamp()
 until = dt.datetime.fromisoformat(a.until).replace(tzinfo=dt.UTC).timestamp()
-calibration = [a.repo / "benchmarks/results/projection_check_preview.json",
-               a.repo / "benchmarks/results/projection_check_h5_h2.5.json"]
+calibration = a.calibration or [a.repo / "benchmarks/results/projection_check_preview.json",
+                                a.repo / "benchmarks/results/projection_check_h5_h2.5.json"]
 plan = make_plan(load_config([], a.repo), cores=2, directory=a.repo, calibration=calibration)
 rows = []
 for tsv in sorted((a.run_dir / "benchmarks" / "runs").glob("*.tsv")):
