@@ -428,12 +428,13 @@ def standard_errors(series: dict[str, np.ndarray], mask: np.ndarray, y: np.ndarr
         se = jackknife_standard_error(lambda k, part=part: part[k].sum() / fz[k].sum(), idx.size)
         if se is not None:
             out[f"{name}_standard_error"] = se
+    phase = lattice_phase_term_m
     groove = {"dp": sum, "dg": lambda d: d[0], "hpu": lambda d: d[1]}
     for name, pick in groove.items():
         se = jackknife_standard_error(
             lambda k, pick=pick: pick(groove_depths(y, _nanmean_rows(prof[k]), contact_radius)), prof.shape[0])
         if se is not None:
-            out[f"{name}_standard_error"] = float(np.hypot(se, lattice_phase_term_m))
+            out[f"{name}_standard_error"] = float(np.hypot(se, phase))
     return out
 
 
