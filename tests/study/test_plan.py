@@ -216,3 +216,56 @@ def test_plough_plan_prints_every_figure_and_the_total(capsys, tmp_path):
     # no measured job given: both families at the cluster request's rate, said so
     assert out.count("none measured") == 2
     assert main(["plan", "--directory", str(tmp_path), "--cores", "0"]) == 2
+
+
+def test_the_plan_leaves_out_what_is_made_and_expects_the_share_of_decisions_that_needed_their_run(tmp_path):
+    """A run counts as made where its result file records its scene and this solver (the files the workflow
+    keeps); what is left is stated as a range and, once decisions are made, as an expected time counting each
+    undecided gated finest run at the share of the decisions made that needed theirs."""
+    from plough.fingerprint import solver_fingerprint
+    from plough.study.plan import describe, made_runs
+
+    config = copy.deepcopy(SMOKE)
+    config["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
+    runs = matrix.all_runs(config)
+    coarser = matrix.skippable_runs(config)
+    gated = sorted(coarser)
+    assert len(gated) >= 4
+    ungated = sorted(set(runs) - set(gated))
+    (tmp_path / "results" / "runs").mkdir(parents=True)
+    (tmp_path / "results" / "refinement").mkdir(parents=True)
+
+    def result(rid: str, scene: dict, solver: str) -> None:
+        xr.Dataset(attrs={"scene": to_json(scene), "solver_fingerprint": solver}).to_netcdf(
+            tmp_path / "results" / "runs" / f"{rid}.nc")
+
+    made, other_solver, other_scene, unreadable = ungated[:4]
+    result(made, runs[made], solver_fingerprint())
+    result(other_solver, runs[other_solver], "0" * 16)
+    result(other_scene, runs[made], solver_fingerprint())  # another run's scene under this run's name
+    (tmp_path / "results" / "runs" / f"{unreadable}.nc").write_text("not netCDF")
+    assert made_runs(tmp_path, runs) == {made}
+
+    # three decisions: two needed, one not; the rest undecided
+    for rid, need in zip(gated[:3], (True, True, False), strict=True):
+        (tmp_path / "results" / "refinement" / f"{rid}.json").write_text(json.dumps(
+            {"run_finest": need, "coarser_runs": list(coarser[rid]), "tolerance": {"mu": 0.05, "dp": 0.3}}))
+    plan = make_plan(config, cores=1, directory=tmp_path)
+    assert plan.done == {made}
+    assert plan.need_share == pytest.approx(2 / 3)
+    left = [r for r in plan.runs if r != made]
+    certain = [r for r in left if r not in gated[2:]]  # the ungated runs and the two decided needed
+    undecided = gated[3:]
+    expected = sum(plan.runs[r].here_s for r in certain) + 2 / 3 * sum(plan.runs[r].here_s for r in undecided)
+    assert plan.expected_wall_s(left) == pytest.approx(expected)  # one job at a time (--cores 1, 1 thread)
+    text = describe(plan)
+    assert (f"made already (results/runs, this solver): 1 of {len(runs)} runs; left: between "
+            f"**{_hours(plan.wall_s(certain))}** ({len(certain)} runs;") in text
+    assert f"and {_hours(plan.wall_s(certain + undecided))} ({len(certain) + len(undecided)} runs; every one made)" \
+        in text
+    assert f"expected **{_hours(expected)}**, each undecided one counted at the share" in text
+    assert "(2 of 3)" in text
+    # before any decision no expectation is made up; with nothing made, no line on what is left
+    fresh = make_plan(config, cores=1, directory=tmp_path / "fresh")
+    assert fresh.need_share is None and fresh.expected_wall_s(list(fresh.runs)) is None
+    assert "made already" not in describe(fresh) and "expected" not in describe(fresh)

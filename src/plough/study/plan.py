@@ -33,6 +33,12 @@ whether a gated finest run is made is known only once its point's two coarser ru
 states a range: every gated finest run made (the upper end, the tables' figures) and every one not
 yet decided skipped (the lower end). Decisions already made (``results/refinement/<run>.json`` under
 the workflow's directory) are followed at both ends.
+
+Resuming: the runs already made under the workflow's directory (``results/runs/<run>.nc`` holding this run's
+scene, made by this solver: the files the workflow would not redo) are left out of what is *left*, stated
+as the same range and, once decisions are made, as an expected time that counts each undecided gated finest
+run at the share of the decisions made so far that needed theirs (a guess from the points decided first,
+which are not a random sample: a point's coarser runs land in the workflow's order, longest first).
 """
 
 from __future__ import annotations
@@ -243,6 +249,8 @@ class Plan:
     figures: dict[str, list[str]]
     #: gated finest run -> its refinement decision: True needed, False not, None not yet made
     gated: dict[str, bool | None] = field(default_factory=dict)
+    #: the runs whose result file under the directory is this run by this solver (a marker included)
+    done: frozenset[str] = frozenset()
 
     def made(self, runs: Iterable[str], *, undecided: bool) -> list[str]:
         """The runs of ``runs`` the workflow makes, each undecided gated finest run counted as ``undecided``."""
@@ -258,6 +266,25 @@ class Plan:
         longest run if longer."""
         times = [self.runs[r].here_s for r in runs]
         return max(sum(times) / self.parallel_jobs, max(times, default=0.0))
+
+    @property
+    def need_share(self) -> float | None:
+        """The share of the refinement decisions made that needed their finest run; None before any."""
+        made = [d for d in self.gated.values() if d is not None]
+        return sum(made) / len(made) if made else None
+
+    def expected_wall_s(self, runs: Iterable[str]) -> float | None:
+        """Wall time here of these runs with each undecided gated finest run counted at :attr:`need_share` of
+        its time (``parallel_jobs`` at a time, never less than the longest run certain to be made); None
+        before any decision is made."""
+        share = self.need_share
+        if share is None:
+            return None
+        runs = list(runs)
+        certain = self.made(runs, undecided=False)
+        open_s = sum(self.runs[r].here_s for r in runs if self.gated.get(r, False) is None)
+        return max((sum(self.runs[r].here_s for r in certain) + share * open_s) / self.parallel_jobs,
+                   max((self.runs[r].here_s for r in certain), default=0.0))
 
 
 def cluster_threads(profile: str | Path | None) -> int | None:
@@ -298,7 +325,32 @@ def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path =
     figures = {fig: [r for r in matrix.figure_runs(config, fig) if r in runs] for fig in ALL_FIGURES}
     tolerance = config["mpm"].get("skip_finest_tolerance")
     return Plan(config, threads, cores, cluster, rates, measured, runs, figures,
-                decisions(directory, matrix.skippable_runs(config), tolerance))
+                decisions(directory, matrix.skippable_runs(config), tolerance),
+                made_runs(directory, matrix.all_runs(config)))
+
+
+def made_runs(directory: Path, runs: Mapping[str, Mapping[str, Any]], solver: str | None = None) -> frozenset[str]:
+    """The runs of ``runs`` (run id -> scene, as the workflow's params) whose result file under ``directory``
+    (``results/runs/<run>.nc``, a skip or failure marker included) records this scene and ``solver`` (default:
+    the solver being run): the files the workflow keeps; any other is redone."""
+    import xarray as xr
+
+    from plough.fingerprint import solver_fingerprint
+    from plough.study.runfiles import RunFileError, check_run
+
+    solver = solver_fingerprint() if solver is None else solver
+    done = set()
+    for rid, scene in runs.items():
+        path = directory / "results" / "runs" / f"{rid}.nc"
+        if not path.exists():
+            continue
+        try:
+            with xr.open_dataset(path) as ds:
+                check_run(ds, path, rid, scene, solver)
+        except (OSError, ValueError, RunFileError):  # unreadable or another run's: the workflow redoes it
+            continue
+        done.add(rid)
+    return frozenset(done)
 
 
 def decisions(directory: Path, gated: Mapping[str, tuple[str, str]],
@@ -395,6 +447,8 @@ def describe(plan: Plan, *, points: bool = False) -> str:
         f"{_hours(sum(r.here_s for r in rs))}" for h, rs in sorted(by_size.items(), reverse=True)))
     if plan.gated:
         lines.append(_refinement(plan))
+    if plan.done:
+        lines.append(_left(plan))
     if longest is not None:
         core_h = sum(r.cluster_s for r in plan.runs.values()) * plan.cluster_threads / 3600
         requested = sum(r.request_min for r in plan.runs.values()) * plan.cluster_threads / 60
@@ -432,7 +486,32 @@ def _refinement(plan: Plan) -> str:
             f"**{_hours(plan.wall_s(low))}** ({len(low)} runs, "
             f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps; every undecided one skipped) and "
             f"{_hours(plan.wall_s(high))} ({len(high)} runs, {sum(plan.runs[r].particle_steps for r in high):.3g} "
-            "particle-steps; every undecided one made)")
+            "particle-steps; every undecided one made)" + _expected(plan, every))
+
+
+def _left(plan: Plan) -> str:
+    """What is left of the workflow where some runs are made: its range and, once decisions are made, the
+    expected time."""
+    left = [r for r in plan.runs if r not in plan.done]
+    text = f"made already (results/runs, this solver): {len(plan.done)} of {len(plan.runs)} runs; left: "
+    if not left:
+        return text + "none (the figures, minutes)"
+    high, low = plan.made(left, undecided=True), plan.made(left, undecided=False)
+    if len(high) == len(low):
+        return text + f"**{_hours(plan.wall_s(low))}** ({len(low)} runs)"
+    text += (f"between **{_hours(plan.wall_s(low))}** ({len(low)} runs; every undecided gated finest run skipped) "
+             f"and {_hours(plan.wall_s(high))} ({len(high)} runs; every one made)")
+    return text + _expected(plan, left)
+
+
+def _expected(plan: Plan, runs: list[str]) -> str:
+    """The expected wall time of ``runs`` as a clause, once refinement decisions are made; else nothing."""
+    expected = plan.expected_wall_s(runs)
+    if expected is None:
+        return ""
+    made = [d for d in plan.gated.values() if d is not None]
+    return (f"; expected **{_hours(expected)}**, each undecided one counted at the share of the decisions made "
+            f"that needed their finest run ({sum(made)} of {len(made)})")
 
 
 def _sources(sources: list[str]) -> list[str]:
