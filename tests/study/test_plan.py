@@ -219,10 +219,11 @@ def test_plough_plan_prints_every_figure_and_the_total(capsys, tmp_path):
 
 
 def test_the_plan_leaves_out_what_is_made_and_expects_the_share_of_decisions_that_needed_their_run(tmp_path):
-    """A run counts as made where its result file records its scene and this solver (the files the workflow
-    keeps); what is left is stated as a range and, once decisions are made, as an expected time counting each
-    undecided gated finest run at the share of the decisions made that needed theirs."""
+    """A run counts as made where its result file records its scene and this solver (a failure marker included,
+    an old skip marker not); what is left is stated as a range and, once decisions are made, as an expected time
+    counting each undecided gated finest run at the share of the decisions made that needed theirs."""
     from plough.fingerprint import solver_fingerprint
+    from plough.study import skipping
     from plough.study.plan import describe, made_runs
 
     config = copy.deepcopy(SMOKE)
@@ -230,42 +231,71 @@ def test_the_plan_leaves_out_what_is_made_and_expects_the_share_of_decisions_tha
     runs = matrix.all_runs(config)
     coarser = matrix.skippable_runs(config)
     gated = sorted(coarser)
-    assert len(gated) >= 4
+    assert len(gated) >= 5
     ungated = sorted(set(runs) - set(gated))
     (tmp_path / "results" / "runs").mkdir(parents=True)
     (tmp_path / "results" / "refinement").mkdir(parents=True)
+    solver = solver_fingerprint()
 
-    def result(rid: str, scene: dict, solver: str) -> None:
-        xr.Dataset(attrs={"scene": to_json(scene), "solver_fingerprint": solver}).to_netcdf(
-            tmp_path / "results" / "runs" / f"{rid}.nc")
+    def write(rid: str, ds: xr.Dataset) -> None:
+        ds.to_netcdf(tmp_path / "results" / "runs" / f"{rid}.nc")
 
-    made, other_solver, other_scene, unreadable = ungated[:4]
-    result(made, runs[made], solver_fingerprint())
-    result(other_solver, runs[other_solver], "0" * 16)
-    result(other_scene, runs[made], solver_fingerprint())  # another run's scene under this run's name
+    def result(rid: str, scene: dict, by: str = solver, **attrs) -> None:
+        write(rid, xr.Dataset(attrs={"scene": to_json(scene), "solver_fingerprint": by, **attrs}))
+
+    made, other_solver, renamed, changed, unreadable = ungated[:5]
+    result(made, runs[made])
+    result(other_solver, runs[other_solver], by="0" * 16)
+    result(renamed, runs[made])  # another run's scene under this run's name
+    scene = copy.deepcopy(runs[changed])
+    scene["load_N"] *= 1.5  # this run's name, one parameter changed: the workflow redoes it
+    result(changed, scene)
     (tmp_path / "results" / "runs" / f"{unreadable}.nc").write_text("not netCDF")
-    assert made_runs(tmp_path, runs) == {made}
+    failed = gated[0]  # decided needed, stopped unstable: its failure marker is kept
+    marker = skipping.failure_marker(runs[failed], failed, "unstable", list(coarser[failed]))
+    marker.attrs["solver_fingerprint"] = solver
+    write(failed, marker)
+    result(gated[2], runs[gated[2]], **{skipping.SKIPPED_ATTR: 1.0})  # an older workflow's skip marker
+    assert made_runs(tmp_path, runs) == {made, failed}
 
     # three decisions: two needed, one not; the rest undecided
-    for rid, need in zip(gated[:3], (True, True, False), strict=True):
+    def decide(rid: str, need: bool) -> None:
         (tmp_path / "results" / "refinement" / f"{rid}.json").write_text(json.dumps(
             {"run_finest": need, "coarser_runs": list(coarser[rid]), "tolerance": {"mu": 0.05, "dp": 0.3}}))
-    plan = make_plan(config, cores=1, directory=tmp_path)
-    assert plan.done == {made}
+
+    for rid, need in zip(gated[:3], (True, True, False), strict=True):
+        decide(rid, need)
+    plan = make_plan(config, cores=2, directory=tmp_path)  # two one-thread jobs at once
+    assert plan.parallel_jobs == 2
+    assert plan.done == {made, failed}
     assert plan.need_share == pytest.approx(2 / 3)
-    left = [r for r in plan.runs if r != made]
-    certain = [r for r in left if r not in gated[2:]]  # the ungated runs and the two decided needed
+    left = [r for r in plan.runs if r not in (made, failed)]
+    certain = [r for r in left if r not in gated[2:]]  # the ungated runs and gated[1], decided needed
     undecided = gated[3:]
-    expected = sum(plan.runs[r].here_s for r in certain) + 2 / 3 * sum(plan.runs[r].here_s for r in undecided)
-    assert plan.expected_wall_s(left) == pytest.approx(expected)  # one job at a time (--cores 1, 1 thread)
-    text = describe(plan)
-    assert (f"made already (results/runs, this solver): 1 of {len(runs)} runs; left: between "
-            f"**{_hours(plan.wall_s(certain))}** ({len(certain)} runs;") in text
-    assert f"and {_hours(plan.wall_s(certain + undecided))} ({len(certain) + len(undecided)} runs; every one made)" \
-        in text
-    assert f"expected **{_hours(expected)}**, each undecided one counted at the share" in text
-    assert "(2 of 3)" in text
+    certain_s = sum(plan.runs[r].here_s for r in certain)
+    expected = max((certain_s + 2 / 3 * sum(plan.runs[r].here_s for r in undecided)) / 2,
+                   max(plan.runs[r].here_s for r in certain))
+    assert plan.expected_wall_s(left) == pytest.approx(expected)
+    line = next(x for x in describe(plan).splitlines() if x.startswith("made already"))
+    assert line == (
+        f"made already (results/runs, this solver): 2 of {len(runs)} runs; left: between "
+        f"**{_hours(plan.wall_s(certain))}** ({len(certain)} runs; every undecided gated finest run skipped) and "
+        f"{_hours(plan.wall_s(certain + undecided))} ({len(certain) + len(undecided)} runs; every one made); "
+        f"expected **{_hours(expected)}**, each undecided one counted at the share of the decisions made that "
+        "needed their finest run (2 of 3)")
+
+    # every decision made: no expectation; every run made but those decided not needed: no run left
+    for rid in gated[3:]:
+        decide(rid, False)
+    text = describe(make_plan(config, cores=2, directory=tmp_path))
+    assert "expected" not in text
+    for rid in set(runs) - set(gated[2:]):
+        result(rid, runs[rid])
+    line = next(x for x in describe(make_plan(config, cores=2, directory=tmp_path)).splitlines()
+                if x.startswith("made already"))
+    assert line.endswith(f"{len(runs) - len(gated[2:])} of {len(runs)} runs; left: no run (the datasets and "
+                         "figures, minutes)")
     # before any decision no expectation is made up; with nothing made, no line on what is left
-    fresh = make_plan(config, cores=1, directory=tmp_path / "fresh")
+    fresh = make_plan(config, cores=2, directory=tmp_path / "fresh")
     assert fresh.need_share is None and fresh.expected_wall_s(list(fresh.runs)) is None
     assert "made already" not in describe(fresh) and "expected" not in describe(fresh)

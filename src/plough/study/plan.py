@@ -249,7 +249,7 @@ class Plan:
     figures: dict[str, list[str]]
     #: gated finest run -> its refinement decision: True needed, False not, None not yet made
     gated: dict[str, bool | None] = field(default_factory=dict)
-    #: the runs whose result file under the directory is this run by this solver (a marker included)
+    #: the runs whose result file under the directory is this run by this solver (a failure marker included)
     done: frozenset[str] = frozenset()
 
     def made(self, runs: Iterable[str], *, undecided: bool) -> list[str]:
@@ -331,23 +331,28 @@ def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path =
 
 def made_runs(directory: Path, runs: Mapping[str, Mapping[str, Any]], solver: str | None = None) -> frozenset[str]:
     """The runs of ``runs`` (run id -> scene, as the workflow's params) whose result file under ``directory``
-    (``results/runs/<run>.nc``, a skip or failure marker included) records this scene and ``solver`` (default:
-    the solver being run): the files the workflow keeps; any other is redone."""
+    (``results/runs/<run>.nc``, a failure marker included) records this scene and ``solver`` (default: the
+    solver being run), read as the workflow reads run files (:func:`plough.study.runfiles.check_run`). Any other
+    file is redone, and so is a skip marker of an older workflow (the figures' datasets refuse them). Not
+    recorded in the files, so not checked: the run script's own code, whose change also reruns every run."""
     import xarray as xr
 
     from plough.fingerprint import solver_fingerprint
-    from plough.study.runfiles import RunFileError, check_run
+    from plough.study.runfiles import check_run
+    from plough.study.skipping import is_skipped
 
     solver = solver_fingerprint() if solver is None else solver
-    done = set()
+    done: set[str] = set()
     for rid, scene in runs.items():
         path = directory / "results" / "runs" / f"{rid}.nc"
         if not path.exists():
             continue
         try:
-            with xr.open_dataset(path) as ds:
+            with xr.open_dataset(path, engine="netcdf4") as ds:
                 check_run(ds, path, rid, scene, solver)
-        except (OSError, ValueError, RunFileError):  # unreadable or another run's: the workflow redoes it
+                if is_skipped(ds):
+                    continue
+        except (OSError, ValueError):  # unreadable, or another run's (RunFileError): the workflow redoes it
             continue
         done.add(rid)
     return frozenset(done)
@@ -494,9 +499,9 @@ def _left(plan: Plan) -> str:
     expected time."""
     left = [r for r in plan.runs if r not in plan.done]
     text = f"made already (results/runs, this solver): {len(plan.done)} of {len(plan.runs)} runs; left: "
-    if not left:
-        return text + "none (the figures, minutes)"
     high, low = plan.made(left, undecided=True), plan.made(left, undecided=False)
+    if not high:  # what is left, if anything, is decided not needed
+        return text + "no run (the datasets and figures, minutes)"
     if len(high) == len(low):
         return text + f"**{_hours(plan.wall_s(low))}** ({len(low)} runs)"
     text += (f"between **{_hours(plan.wall_s(low))}** ({len(low)} runs; every undecided gated finest run skipped) "
@@ -505,9 +510,10 @@ def _left(plan: Plan) -> str:
 
 
 def _expected(plan: Plan, runs: list[str]) -> str:
-    """The expected wall time of ``runs`` as a clause, once refinement decisions are made; else nothing."""
+    """The expected wall time of ``runs`` as a clause, once refinement decisions are made and while some run
+    of ``runs`` is undecided; else nothing."""
     expected = plan.expected_wall_s(runs)
-    if expected is None:
+    if expected is None or all(plan.gated.get(r, False) is not None for r in runs):
         return ""
     made = [d for d in plan.gated.values() if d is not None]
     return (f"; expected **{_hours(expected)}**, each undecided one counted at the share of the decisions made "
