@@ -268,10 +268,19 @@ class Plan:
         return max(sum(times) / self.parallel_jobs, max(times, default=0.0))
 
     @property
+    def decided(self) -> list[bool]:
+        """The refinement decisions made: True where the finest run was needed."""
+        return [d for d in self.gated.values() if d is not None]
+
+    def undecided(self, runs: Iterable[str]) -> list[str]:
+        """The gated finest runs of ``runs`` whose decision is not yet made."""
+        return [r for r in runs if r in self.gated and self.gated[r] is None]
+
+    @property
     def need_share(self) -> float | None:
         """The share of the refinement decisions made that needed their finest run; None before any."""
-        made = [d for d in self.gated.values() if d is not None]
-        return sum(made) / len(made) if made else None
+        decided = self.decided
+        return sum(decided) / len(decided) if decided else None
 
     def expected_wall_s(self, runs: Iterable[str]) -> float | None:
         """Wall time here of these runs with each undecided gated finest run counted at :attr:`need_share` of
@@ -282,7 +291,7 @@ class Plan:
             return None
         runs = list(runs)
         certain = self.made(runs, undecided=False)
-        open_s = sum(self.runs[r].here_s for r in runs if self.gated.get(r, False) is None)
+        open_s = sum(self.runs[r].here_s for r in self.undecided(runs))
         return max((sum(self.runs[r].here_s for r in certain) + share * open_s) / self.parallel_jobs,
                    max((self.runs[r].here_s for r in certain), default=0.0))
 
@@ -310,7 +319,8 @@ def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path =
 
     directory = Path(directory)
     threads = int(config["mpm"]["threads"])
-    scenes = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(config).items()}
+    params = matrix.all_runs(config)
+    scenes = {rid: Scene.from_dict(s) for rid, s in params.items()}
     files = [Path(f) for f in calibration] if calibration is not None else sorted(directory.glob(CALIBRATION_FILES))
     measured = measured_from_json(files) + measured_from_benchmarks(directory, scenes, threads)
     rates = Rates.from_measured(measured, threads)
@@ -326,7 +336,7 @@ def make_plan(config: dict[str, Any], *, cores: int = 2, directory: str | Path =
     tolerance = config["mpm"].get("skip_finest_tolerance")
     return Plan(config, threads, cores, cluster, rates, measured, runs, figures,
                 decisions(directory, matrix.skippable_runs(config), tolerance),
-                made_runs(directory, matrix.all_runs(config)))
+                made_runs(directory, params))
 
 
 def made_runs(directory: Path, runs: Mapping[str, Mapping[str, Any]], solver: str | None = None) -> frozenset[str]:
@@ -502,7 +512,7 @@ def _left(plan: Plan) -> str:
     high, low = plan.made(left, undecided=True), plan.made(left, undecided=False)
     if not high:  # what is left, if anything, is decided not needed
         return text + "no run (the datasets and figures, minutes)"
-    if len(high) == len(low):
+    if not plan.undecided(left):
         return text + f"**{_hours(plan.wall_s(low))}** ({len(low)} runs)"
     text += (f"between **{_hours(plan.wall_s(low))}** ({len(low)} runs; every undecided gated finest run skipped) "
              f"and {_hours(plan.wall_s(high))} ({len(high)} runs; every one made)")
@@ -513,11 +523,11 @@ def _expected(plan: Plan, runs: list[str]) -> str:
     """The expected wall time of ``runs`` as a clause, once refinement decisions are made and while some run
     of ``runs`` is undecided; else nothing."""
     expected = plan.expected_wall_s(runs)
-    if expected is None or all(plan.gated.get(r, False) is not None for r in runs):
+    if expected is None or not plan.undecided(runs):
         return ""
-    made = [d for d in plan.gated.values() if d is not None]
+    decided = plan.decided
     return (f"; expected **{_hours(expected)}**, each undecided one counted at the share of the decisions made "
-            f"that needed their finest run ({sum(made)} of {len(made)})")
+            f"that needed their finest run ({sum(decided)} of {len(decided)})")
 
 
 def _sources(sources: list[str]) -> list[str]:
