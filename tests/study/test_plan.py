@@ -287,8 +287,15 @@ def test_the_plan_leaves_out_what_is_made_and_expects_the_share_of_decisions_tha
     # every decision made: no expectation; every run made but those decided not needed: no run left
     for rid in gated[3:]:
         decide(rid, False)
-    text = describe(make_plan(config, cores=2, directory=tmp_path))
+    decided = make_plan(config, cores=2, directory=tmp_path)
+    text = describe(decided)
     assert "expected" not in text
+    # ... and one number, not a range from a number to itself
+    needed = decided.made(list(decided.runs), undecided=False)
+    refinement = next(x for x in text.splitlines() if x.startswith("refinement only where needed"))
+    assert refinement.endswith(
+        f"(2 decided needed, {len(gated) - 2} decided not, 0 undecided): **{_hours(decided.wall_s(needed))}** "
+        f"({len(needed)} runs, {sum(decided.runs[r].particle_steps for r in needed):.3g} particle-steps)")
     for rid in set(runs) - set(gated[2:]):
         result(rid, runs[rid])
     line = next(x for x in describe(make_plan(config, cores=2, directory=tmp_path)).splitlines()

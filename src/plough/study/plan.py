@@ -496,9 +496,12 @@ def _refinement(plan: Plan) -> str:
     from plough.study.skipping import tolerances
 
     tol = ", ".join(f"{o} {t:g}" for o, t in tolerances(plan.config["mpm"]["skip_finest_tolerance"]).items())
-    return (f"refinement only where needed (skip_finest_tolerance: {tol}): {len(states)} gated finest runs "
-            f"({n_need} decided needed, {n_skip} decided not, {n_open} undecided): between "
-            f"**{_hours(plan.wall_s(low))}** ({len(low)} runs, "
+    text = (f"refinement only where needed (skip_finest_tolerance: {tol}): {len(states)} gated finest runs "
+            f"({n_need} decided needed, {n_skip} decided not, {n_open} undecided): ")
+    if not n_open:  # every decision made: one number, not a range
+        return text + (f"**{_hours(plan.wall_s(low))}** ({len(low)} runs, "
+                       f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps)")
+    return (text + f"between **{_hours(plan.wall_s(low))}** ({len(low)} runs, "
             f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps; every undecided one skipped) and "
             f"{_hours(plan.wall_s(high))} ({len(high)} runs, {sum(plan.runs[r].particle_steps for r in high):.3g} "
             "particle-steps; every undecided one made)" + _expected(plan, every))
