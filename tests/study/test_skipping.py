@@ -162,6 +162,26 @@ def test_a_newer_run_without_its_dp_error_never_skips():
     ex = skipping.two_size_extrapolation(coarse, newer, 20.0, 10.0)
     assert np.isnan(ex["dp"]["sampling_error"]) and ex["mu"]["sampling_error"] == 0.0
     assert not skipping.should_skip(ex, 0.5)
+    # the decision the checkpoint writes says so in strict JSON (null, never NaN) and in its reason
+    d = skipping.decide("p_h10", _scene_run(0.40, 5e-6, 40.0, "p_h40"),
+                        _scene_run(0.41, 5e-6, 20.0, "p_h20").assign(mu_standard_error=0.0),
+                        ["p_h40", "p_h20"], 0.5)
+    assert d["run_finest"] is True
+    assert d["extrapolations"]["dp"]["sampling_error"] is None
+    assert d["extrapolations"]["dp"]["relative_uncertainty"] is None
+    assert d["extrapolations"]["dp"]["value"] == pytest.approx(5e-6, rel=1e-12)
+    assert d["extrapolations"]["mu"]["sampling_error"] == 0.0
+    assert json.loads(json.dumps(d, allow_nan=False)) == d
+    assert d["reason"].endswith("dp unknown (a coarser run could not estimate its sampling error)")
+    # a groove of 0 at both sizes: nothing uncertain; a limit of exactly 0 from two grooves: unbounded
+    flat = skipping.decide("p_h10", _scene_run(0.40, 0.0, 40.0, "p_h40"), _scene_run(0.41, 0.0, 20.0, "p_h20"),
+                           ["p_h40", "p_h20"], 0.5)
+    assert flat["extrapolations"]["dp"]["relative_uncertainty"] == 0.0  # 0 / 0: nothing uncertain
+    zero_limit = skipping.decide("p_h10", _scene_run(0.40, 2e-6, 40.0, "p_h40"), _scene_run(0.41, 1e-6, 20.0, "p_h20"),
+                                 ["p_h40", "p_h20"], 0.5)
+    assert zero_limit["extrapolations"]["dp"]["relative_uncertainty"] is None and zero_limit["run_finest"] is True
+    assert "dp unbounded (the limit is 0)" in zero_limit["reason"]
+    json.dumps(zero_limit, allow_nan=False)
 
 
 def test_failure_marker_carries_the_message_and_no_results():

@@ -32,7 +32,7 @@ def decide(log) -> None:
     out.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{out.name}.", suffix=".part", dir=out.parent)
     with os.fdopen(fd, "w") as f:
-        json.dump(decision, f, indent=1)
+        json.dump(decision, f, indent=1, allow_nan=False)  # strict JSON: not-a-number is null (skipping.decide)
     os.replace(tmp, out)
     print(f"{'run' if decision['run_finest'] else 'skip'} {smk.wildcards.run}: {decision['reason']}", file=log)
 

@@ -124,11 +124,24 @@ def decide(finest_run: str, coarse: xr.Dataset, mid: xr.Dataset, coarse_runs: li
     sizes = [run_size_um(coarse), run_size_um(mid)]
     ex = two_size_extrapolation(coarse, mid, sizes[0], sizes[1])
     skip = should_skip(ex, tolerance)
+    # strict JSON: a number that is not finite (a sampling error not estimable, a limit of 0) is written as null
+    # and named in the reason, never as NaN or Infinity
+    written = {o: {k: (v if np.isfinite(v) else None) for k, v in e.items()} for o, e in ex.items()}
     return {"finest_run": finest_run, "run_finest": not skip, "coarser_runs": list(coarse_runs),
-            "coarser_sizes_um": sizes, "tolerance": tolerances(tolerance), "extrapolations": ex,
+            "coarser_sizes_um": sizes, "tolerance": tolerances(tolerance), "extrapolations": written,
             "reason": (f"the two-size extrapolation of {', '.join(coarse_runs)} (h = {sizes[0]:g}, {sizes[1]:g} um) is "
                        f"{'not ' if not skip else ''}within skip_finest_tolerance for {', '.join(ex)}: relative "
-                       "uncertainty " + ", ".join(f"{o} {e['relative_uncertainty']:.3g}" for o, e in ex.items()))}
+                       "uncertainty " + ", ".join(f"{o} {_relative(e)}" for o, e in ex.items()))}
+
+
+def _relative(extrapolation: dict[str, float]) -> str:
+    """A relative uncertainty for the decision's reason; where it is not a number, why."""
+    rel = extrapolation["relative_uncertainty"]
+    if np.isfinite(rel):
+        return f"{rel:.3g}"
+    if not np.isfinite(extrapolation["sampling_error"]):
+        return "unknown (a coarser run could not estimate its sampling error)"
+    return "unbounded (the limit is 0)"
 
 
 def is_skipped(ds: xr.Dataset) -> bool:
