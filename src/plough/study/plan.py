@@ -499,12 +499,9 @@ def _refinement(plan: Plan) -> str:
     text = (f"refinement only where needed (skip_finest_tolerance: {tol}): {len(states)} gated finest runs "
             f"({n_need} decided needed, {n_skip} decided not, {n_open} undecided): ")
     if not n_open:  # every decision made: one number, not a range
-        return text + (f"**{_hours(plan.wall_s(low))}** ({len(low)} runs, "
-                       f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps)")
-    return (text + f"between **{_hours(plan.wall_s(low))}** ({len(low)} runs, "
-            f"{sum(plan.runs[r].particle_steps for r in low):.3g} particle-steps; every undecided one skipped) and "
-            f"{_hours(plan.wall_s(high))} ({len(high)} runs, {sum(plan.runs[r].particle_steps for r in high):.3g} "
-            "particle-steps; every undecided one made)" + _expected(plan, every))
+        return text + _amount(plan, low, bold=True, particle_steps=True)
+    return (text + "between " + _amount(plan, low, "every undecided one skipped", bold=True, particle_steps=True)
+            + " and " + _amount(plan, high, "every undecided one made", particle_steps=True) + _expected(plan, every))
 
 
 def _left(plan: Plan) -> str:
@@ -516,10 +513,21 @@ def _left(plan: Plan) -> str:
     if not high:  # what is left, if anything, is decided not needed
         return text + "no run (the datasets and figures, minutes)"
     if not plan.undecided(left):
-        return text + f"**{_hours(plan.wall_s(low))}** ({len(low)} runs)"
-    text += (f"between **{_hours(plan.wall_s(low))}** ({len(low)} runs; every undecided gated finest run skipped) "
-             f"and {_hours(plan.wall_s(high))} ({len(high)} runs; every one made)")
+        return text + _amount(plan, low, bold=True)
+    text += ("between " + _amount(plan, low, "every undecided gated finest run skipped", bold=True) + " and "
+             + _amount(plan, high, "every one made"))
     return text + _expected(plan, left)
+
+
+def _amount(plan: Plan, runs: list[str], note: str = "", *, bold: bool = False,
+            particle_steps: bool = False) -> str:
+    """``runs``' wall time here with their count (and particle-steps, and a note) in brackets: "**3.1 h** (12
+    runs, 4.5e+10 particle-steps; every one made)"."""
+    hours = f"**{_hours(plan.wall_s(runs))}**" if bold else _hours(plan.wall_s(runs))
+    what = f"{len(runs)} runs"
+    if particle_steps:
+        what += f", {sum(plan.runs[r].particle_steps for r in runs):.3g} particle-steps"
+    return f"{hours} ({what}{'; ' + note if note else ''})"
 
 
 def _expected(plan: Plan, runs: list[str]) -> str:
