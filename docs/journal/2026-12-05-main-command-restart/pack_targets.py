@@ -27,8 +27,7 @@ a = p.parse_args()
 
 config = load_config([], a.run_dir)
 plan = make_plan(config, cores=a.cores, directory=a.run_dir, calibration=a.calibration)
-left = [r for r in plan.runs.values()
-        if r.run not in plan.done and (r.run not in plan.gated or plan.gated[r.run] is True)]
+left = [plan.runs[r] for r in plan.made((r for r in plan.runs if r not in plan.done), undecided=False)]
 left.sort(key=lambda r: -r.particle_steps)  # mpm_run's priority (workflow/rules/common.smk)
 budget_s = a.minutes * 60
 cores = [0.0] * plan.parallel_jobs
