@@ -14,6 +14,8 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
+from plough.study.extrapolation import Method
+
 
 def against_analytical(ds: xr.Dataset, q: str, sfx: str) -> str:
     """'min-max ratio | n of m within bars' of quantity q's h -> 0 value against the analytical model's."""
@@ -31,7 +33,7 @@ def against_analytical(ds: xr.Dataset, q: str, sfx: str) -> str:
 p = argparse.ArgumentParser()
 p.add_argument("folder", type=Path)
 a = p.parse_args()
-print("| figure | panel | points | mu: richardson / least squares / two sizes / converged / missing | mu flagged "
+print(f"| figure | panel | points | mu: {' / '.join(m.name.lower() for m in Method)} | mu flagged "
       "| dp flagged | runs | runs not steady | median relative uncertainty of mu | mu / analytical "
       "| mu within its bars | dp / analytical | dp within its bars |")
 print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
@@ -40,10 +42,10 @@ for nc in sorted(a.folder.glob("fig*.nc")):
         for name in sorted(v for v in ds.data_vars if v.startswith("mu_h0_method")):
             sfx = name.removeprefix("mu_h0_method")
             method = ds[name].values.ravel()
-            have = method != 4
-            counts = " / ".join(str(int(np.sum(method == k))) for k in range(5))
+            have = method != Method.MISSING
+            counts = " / ".join(str(int(np.sum(method == m))) for m in Method)
             mu_flag = int(np.sum(ds[f"mu_h0_flagged{sfx}"].values.ravel()[have]))
-            dp_have = ds[f"dp_h0_method{sfx}"].values.ravel() != 4
+            dp_have = ds[f"dp_h0_method{sfx}"].values.ravel() != Method.MISSING
             dp_flag = int(np.sum(ds[f"dp_h0_flagged{sfx}"].values.ravel()[dp_have]))
             made = np.isfinite(ds[f"mu{sfx}"].values)
             not_steady = int(np.sum(made & (ds[f"steady{sfx}"].values == 0)))

@@ -6,11 +6,12 @@ one-thread job time of the constant one (benchmarks/runs/<run>.tsv).
     PYTHONPATH=src python identical_pairs.py RUN_DIR
 """
 import argparse
-import csv
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
+
+from plough.study.plan import job_seconds
 
 p = argparse.ArgumentParser()
 p.add_argument("run_dir", type=Path)
@@ -26,8 +27,7 @@ for const in sorted(runs.glob("rp_*_const450_*.nc")):
     with xr.open_dataset(const) as c, xr.open_dataset(twin) as t:
         same = all(np.array_equal(c[v].values, t[v].values) for v in ("Fx", "Fy", "Fz", "depth"))
         regime = c.attrs.get("interface_regime", "").split("(")[0].split(",")[0].strip()
-    with (a.run_dir / "benchmarks" / "runs" / f"{const.stem}.tsv").open() as f:
-        s = float(next(csv.DictReader(f, delimiter="\t"))["s"])
+    s = job_seconds(a.run_dir / "benchmarks" / "runs" / f"{const.stem}.tsv")
     same_s += s if same else 0.0
     print(f"| {const.stem} | {'yes' if same else 'no'} | {s:.0f} | {regime} |")
 print(f"\nbitwise-equal pairs: {same_s:.0f} s of one-thread jobs made twice")

@@ -5,13 +5,14 @@ run's time repeats between sessions on this machine.
     PYTHONPATH=src python rerun_vs_first.py RUN_DIR FIRST_JSON [--until 2026-12-05T12:20:00]
 """
 import argparse
-import csv
 import datetime as dt
 import json
 import statistics
 from pathlib import Path
 
 import xarray as xr
+
+from plough.study.plan import job_seconds
 
 p = argparse.ArgumentParser()
 p.add_argument("run_dir", type=Path)
@@ -30,8 +31,7 @@ for tsv in sorted((a.run_dir / "benchmarks" / "runs").glob("*.tsv")):
     old = first[tsv.stem]
     if threads != old["threads"]:
         continue
-    with tsv.open() as f:
-        s = float(next(csv.DictReader(f, delimiter="\t"))["s"])
+    s = job_seconds(tsv)
     rows.append((tsv.stem, old["family"], old["h_um"], old["measured_s"], s))
 rows.sort(key=lambda r: -r[3])
 print(f"{len(rows)} jobs made in both measurements at the same threads")

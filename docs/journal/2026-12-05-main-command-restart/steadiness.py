@@ -6,12 +6,15 @@ half to the second) beyond 2 particle sizes (plough.mpm.io). Grouped by family a
 """
 import argparse
 import json
+import statistics
 from collections import defaultdict
 from pathlib import Path
 
 import xarray as xr
 
-from plough.mpm.io import STEADY_MU_DRIFT
+from plough.mpm.io import STEADY_MU_DRIFT, STEADY_TOP_RISE_PARTICLES
+from plough.mpm.scene import Scene
+from plough.study.plan import family_of
 
 p = argparse.ArgumentParser()
 p.add_argument("run_dir", type=Path)
@@ -21,18 +24,18 @@ for nc in sorted((a.run_dir / "results" / "runs").glob("*.nc")):
     with xr.open_dataset(nc) as ds:
         if "steady" not in ds:
             continue
-        h_um = json.loads(ds.attrs["scene"])["discretisation"]["particle_size_m"] * 1e6
-        family = "rigid-plastic" if nc.stem.startswith("rp_") else "real materials"
-        rise_h = float(ds["material_top_rise"]) / (h_um * 1e-6)
-        groups[(family, h_um)].append((nc.stem, float(ds["mu_drift"]), rise_h, int(ds["steady"])))
+        scene = Scene.from_dict(json.loads(ds.attrs["scene"]))
+        h_m = scene.discretisation.particle_size_m
+        rise_h = float(ds["material_top_rise"]) / h_m
+        groups[(family_of(scene), h_m * 1e6)].append((nc.stem, float(ds["mu_drift"]), rise_h, int(ds["steady"])))
 print("| family | h (um) | runs | not steady | by mu drift only | by top rise only | by both | median abs mu drift |")
 print("|---|---|---|---|---|---|---|---|")
 for (family, h_um), rows in sorted(groups.items(), key=lambda kv: (kv[0][0], -kv[0][1])):
     bad = [r for r in rows if not r[3]]
     drift = [r for r in bad if abs(r[1]) > STEADY_MU_DRIFT]
-    rise = [r for r in bad if abs(r[2]) > 2]
-    both = [r for r in drift if abs(r[2]) > 2]
-    med = sorted(abs(r[1]) for r in rows)[len(rows) // 2]
+    rise = [r for r in bad if abs(r[2]) > STEADY_TOP_RISE_PARTICLES]
+    both = [r for r in drift if abs(r[2]) > STEADY_TOP_RISE_PARTICLES]
+    med = statistics.median(abs(r[1]) for r in rows)
     print(f"| {family} | {h_um:g} | {len(rows)} | {len(bad)} | {len(drift) - len(both)} | {len(rise) - len(both)} "
           f"| {len(both)} | {med:.3f} |")
 print()
