@@ -15,7 +15,7 @@ import pytest
 import yaml
 
 from plough.analytical import ploughing
-from plough.materials import get_material, representative_hardness
+from plough.materials import ConstantShear, get_material, representative_hardness
 from plough.mpm.scene import CONTACT_MODES, Discretisation, Scene
 from plough.study import matrix
 
@@ -53,12 +53,16 @@ def expected_points(config: dict) -> tuple[set, set]:
     mpm = config["mpm"]
     rp, real = mpm["rigid_plastic"], mpm["real_materials"]
 
-    def iface(name):
-        return ("constant", _r(rp["H0_MPa"])) if name == "constant" else ("proportional", _r(rp.get("f", 1.0)))
+    def iface(name, hardnesses):
+        # the solver caps tau at kappa: a constant H0 at or above every layer's hardness is the f = 1 law
+        if name == "constant" and rp["H0_MPa"] < max(hardnesses):
+            return ("constant", _r(rp["H0_MPa"]))
+        return ("proportional", _r(1.0 if name == "constant" else rp.get("f", 1.0)))
 
     def rp_point(ratio, hs, t, name):
         t = _r(t)
-        return ("rp", _r(ratio * hs) if t > 0 else None, _r(hs), t, iface(name), _r(rp["radius_um"]),
+        hardnesses = (ratio * hs, hs) if t > 0 else (hs,)
+        return ("rp", _r(ratio * hs) if t > 0 else None, _r(hs), t, iface(name, hardnesses), _r(rp["radius_um"]),
                 _r(rp["load_N"]))
 
     def real_pt(system, radius, load, t=None):
@@ -125,13 +129,14 @@ def test_run_count_is_distinct_points_times_sizes_plus_finest_pictures(config, c
     assert len(matrix.all_points(config)) == len(sweep | single)
     if config_name == "config":
         # spelled out for the full matrix: rigid plastic 7 ratios x 2 interfaces + 11 thicknesses x 2 cases,
-        # less the hard t = 25 um proportional point that is also in the ratio sweep (Figs. 11/13 share runs);
+        # less the 4 constant-interface points at H~ <= 1 (H0 = 450 MPa >= both hardnesses: the f = 1 law, the
+        # proportional point's run) and the hard t = 25 um proportional point that is also in the ratio sweep;
         # real materials: zinc block + steel (Figs. 15/20) and the coated steel with two balls (Figs. 16/21),
         # each at 7 loads, plus 5 coating thicknesses of Fig. 18 less the t = 15 um one of Fig. 16 (its
         # bulk zinc point is Fig. 15's at 22 N); every picture point (Figs. 12, 14, 17, 19) is a sweep point.
-        assert len(sweep) == (7 * 2 + 11 * 2 - 1) + (2 * 7 + 2 * 7 + 5 - 1) == 67
+        assert len(sweep) == (7 * 2 - 4 + 11 * 2 - 1) + (2 * 7 + 2 * 7 + 5 - 1) == 63
         assert single <= sweep
-        assert len(runs) == 67 * 3 == 201
+        assert len(runs) == 63 * 3 == 189
 
 
 def test_runs_are_the_union_of_the_figures_runs(config, runs):
@@ -153,6 +158,36 @@ def test_shared_figures_share_runs(config):
     assert fig18_std <= set(runs_of["fig16"])
     # Fig. 23 is made of Fig. 15's and Fig. 16's runs only
     assert set(runs_of["fig23"]) <= set(runs_of["fig15"]) | set(runs_of["fig16"])
+
+
+def test_a_constant_interface_the_solver_caps_everywhere_shares_the_proportional_run(config):
+    """Fig. 11a's constant-interface point is the proportional (f = 1) point's run where H0 is at or above both
+    hardnesses (the solver caps tau at kappa), its own run where the coating is harder; the analytical values
+    stay the constant law's (eq. 8 is not capped)."""
+    rp = config["mpm"]["rigid_plastic"]
+    rs = rp["ratio_sweep"]
+    if not {"constant", "proportional"} <= set(rs["interfaces"]) or float(rp.get("f", 1.0)) != 1.0:
+        pytest.skip("needs both interfaces with f = 1")
+    a = matrix.figure_panels(config, "fig11")[0]
+    const = a.series[rs["interfaces"].index("constant")].points
+    prop = a.series[rs["interfaces"].index("proportional")].points
+    shared = 0
+    for ratio, c, p in zip(rs["hardness_ratio"], const, prop, strict=True):
+        below = float(rp["H0_MPa"]) >= max(float(ratio), 1.0) * float(rs["substrate_hardness_MPa"])
+        assert (c.key == p.key) is below, (ratio, c.key)
+        assert c.interface == ({"model": "proportional", "f": 1.0} if below
+                               else {"model": "constant", "H0_Pa": float(rp["H0_MPa"]) * 1e6})
+        assert matrix.scene_for(c, 5.0, config["mpm"]["numerics"]).interface == (
+            matrix.scene_for(p, 5.0, config["mpm"]["numerics"]).interface if below
+            else ConstantShear(H0_Pa=float(rp["H0_MPa"]) * 1e6))
+        # the analytical model keeps the uncapped constant law (tau = H0 / k0 above the soft coating's kappa)
+        direct = ploughing(float(rp["load_N"]), float(rp["radius_um"]) * 1e-6, float(rs["thickness_um"]) * 1e-6,
+                           float(ratio) * float(rs["substrate_hardness_MPa"]) * 1e6,
+                           float(rs["substrate_hardness_MPa"]) * 1e6, k1=float(rs["k1"]), interface="constant",
+                           H0_Pa=float(rp["H0_MPa"]) * 1e6)
+        assert matrix.analytical_values(c)["mu"] == pytest.approx(float(direct.mu), rel=1e-12)
+        shared += below
+    assert shared >= 1
 
 
 def test_sweep_points_at_every_size_pictures_at_the_finest(config):
@@ -200,7 +235,8 @@ def _steel_runs(runs: dict) -> set[str]:
 @pytest.mark.parametrize(("path", "value", "affected"), [
     (("real_materials", "lubricants", "dx56", "Cp"), 1.5, "steel"),
     (("real_materials", "lubricants", "zinc", "np"), 0.9, "zinc"),
-    (("rigid_plastic", "H0_MPa"), 400, "constant"),
+    # 500 MPa, above 450: the constant points at H~ <= 1 stay the f = 1 law (test above), the others change
+    (("rigid_plastic", "H0_MPa"), 500, "constant"),
 ], ids=["lubricant_dx56_Cp", "lubricant_zinc_np", "H0_MPa"])
 def test_changing_a_parameter_changes_exactly_the_runs_that_use_it(config, runs, path, value, affected):
     changed_config = copy.deepcopy(config)

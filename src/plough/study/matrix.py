@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from plough.materials import interface_from_dict, representative_hardness
+from plough.materials import interface_from_dict, interface_to_dict, representative_hardness
 from plough.mpm.scene import (
     Discretisation,
     Domain,
@@ -38,6 +38,7 @@ from plough.mpm.scene import (
     expected_contact,
     material_from_spec,
     sized_domain,
+    solver_interface,
 )
 from plough.study import cost
 
@@ -186,8 +187,12 @@ class Point:
     thickness_m: float
     substrate: Any  # material spec: a name or {"rigid_plastic_hardness_Pa": H}
     coating: Any | None
+    #: the interface law the MPM runs (``plough.mpm.scene.solver_interface`` of the config's law)
     interface: dict[str, Any]
     k1: float = field(default=125.0, compare=False)  # the analytical model's only: one run serves any k1
+    #: the config's interface law where it differs from ``interface`` (the analytical model's only: its
+    #: constant shear is not capped at kappa, the solver's is); None: the same
+    analytical_interface: dict[str, Any] | None = field(default=None, compare=False)
     #: the config key each of the scene's physical keys comes from (``load_N``, ``sphere.radius_m``,
     #: ``layers.coating_thickness_m``), so that a refused scene names what to change in the config
     source: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
@@ -242,13 +247,21 @@ def rigid_plastic_point(rp: dict[str, Any], ratio: float, substrate_MPa: float, 
                         interface: str, k1: float, *, where: str = "mpm.rigid_plastic") -> Point:
     """A rigid-plastic point; ``where``: the config section its thickness comes from (for messages)."""
     Hs, Hc = float(substrate_MPa), float(ratio) * float(substrate_MPa)
-    iface = _interface(interface, rp)
+    declared = _interface(interface, rp)
     t = float(thickness_um)
+    substrate = {"rigid_plastic_hardness_Pa": Hs * 1e6}
+    coating = {"rigid_plastic_hardness_Pa": Hc * 1e6} if t > 0 else None
+    layers = Layers(substrate=material_from_spec(substrate, coating=False, where=f"{where}.substrate_hardness_MPa"),
+                    coating=None if coating is None else material_from_spec(coating, coating=True,
+                                                                             where=f"{where}.hardness_ratio"),
+                    coating_thickness_m=t * 1e-6)
+    # a constant interface at or above both hardnesses runs as the proportional f = 1 law: one run for both
+    iface = interface_to_dict(solver_interface(layers, interface_from_dict(declared)))
     coated = f"Hc{fmt(Hc)}_Hs{fmt(Hs)}_t{fmt(t)}" if t > 0 else f"Hs{fmt(Hs)}_t0"
     key = f"rp_{coated}_{_interface_key(iface)}_r{fmt(rp['radius_um'])}_F{fmt(rp['load_N'])}"
     return Point(key=key, load_N=float(rp["load_N"]), radius_m=float(rp["radius_um"]) * 1e-6, thickness_m=t * 1e-6,
-                 substrate={"rigid_plastic_hardness_Pa": Hs * 1e6},
-                 coating={"rigid_plastic_hardness_Pa": Hc * 1e6} if t > 0 else None, interface=iface, k1=float(k1),
+                 substrate=substrate, coating=coating, interface=iface, k1=float(k1),
+                 analytical_interface=None if iface == declared else declared,
                  source={"load_N": "mpm.rigid_plastic.load_N", "sphere.radius_m": "mpm.rigid_plastic.radius_um",
                          "layers.coating_thickness_m": f"{where}.thickness_um"})
 
@@ -621,7 +634,7 @@ def analytical_values(point: Point, correction: str = "none") -> dict[str, float
     from plough.analytical import ploughing
 
     Hc, Hs = point.hardnesses_Pa()
-    iface = point.interface
+    iface = point.interface if point.analytical_interface is None else point.analytical_interface
     kw: dict[str, Any] = {"interface": iface["model"]}
     if iface["model"] == "constant":
         kw["H0_Pa"] = iface["H0_Pa"]
