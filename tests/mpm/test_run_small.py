@@ -145,29 +145,6 @@ def test_material_top_bounds_the_residual_surface(tiny_run, tiny_scene):
     assert top.max() < tiny_scene.grid_headroom_m
 
 
-def test_a_constant_interface_above_every_hardness_runs_as_the_proportional_f1_law():
-    """The reason ``scene.solver_interface`` may name the two laws alike (and the study make them one run): on a
-    450 MPa coating 15 um thick over the 900 MPa substrate (a particle straddling the interface mixes the two),
-    tau = 1000 MPa / k0 is capped at kappa everywhere and the run is the f = 1 run, bit for bit; at 300 MPa,
-    under the coating's hardness, it is not (mu a third lower)."""
-    layered = {"layers": {"substrate": {"rigid_plastic_hardness_MPa": 900},
-                          "coating": {"rigid_plastic_hardness_MPa": 450}, "coating_thickness_um": 15},
-               "domain": {"radius_um": 100, "length_um": 340, "symmetric": True},
-               "sliding": {"distance_um": 130, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001}}
-    runs = {}
-    for name, interface in (("f1", {"model": "proportional", "f": 1.0}),
-                            ("H0_1000", {"model": "constant", "H0_MPa": 1000}),
-                            ("H0_300", {"model": "constant", "H0_MPa": 300})):
-        scene = Scene.from_dict(scene_dict(interface=interface, **layered))
-        runs[name] = (scene, simulate(scene, progress=False, threads=1))
-    above, below = runs["H0_1000"][0], runs["H0_300"][0]
-    assert scene_module.solver_interface(above.layers, above.interface) == runs["f1"][0].interface
-    assert scene_module.solver_interface(below.layers, below.interface) == below.interface
-    for var in ("Fx", "Fz", "depth"):
-        np.testing.assert_array_equal(runs["H0_1000"][1][var].values, runs["f1"][1][var].values)
-    assert float(runs["H0_300"][1].mu) < 0.8 * float(runs["f1"][1].mu)
-
-
 def test_steadiness_is_reported_from_the_run_records(tiny_run, tiny_scene):
     ds = tiny_run
     mask = ds.in_steady_window.values

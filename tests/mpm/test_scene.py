@@ -17,18 +17,10 @@ import numpy as np
 import pytest
 import yaml
 
-from plough.materials import (
-    DX56,
-    ZINC_BULK,
-    ZINC_COATING,
-    BoundaryLayerShear,
-    ConstantShear,
-    ProportionalShear,
-    rigid_plastic,
-)
+from plough.materials import DX56, ZINC_BULK, ZINC_COATING, ConstantShear, ProportionalShear, rigid_plastic
 from plough.mpm import contact, io, solver
 from plough.mpm.constitutive import I_RHO
-from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding, solver_interface
+from plough.mpm.scene import Discretisation, Domain, Layers, Scene, Sliding
 
 EXAMPLES_DIR = Path(__file__).resolve().parents[2] / "examples"
 EXAMPLES = sorted(EXAMPLES_DIR.glob("*.yaml"))
@@ -564,25 +556,6 @@ def test_interface_ratio_counts_the_substrate_once_the_sphere_ploughs_through():
     thick = _coated_constant_scene(100.0, 900.0, 450.0)
     assert thick.expected_contact()[1] < 100e-6
     assert thick.interface_strength_ratio == pytest.approx(0.5, rel=1e-12) and not thick.interface_sticks
-
-
-def test_a_constant_interface_at_or_above_every_hardness_is_the_proportional_f1_law():
-    """The solver caps tau at kappa = sigma_y / sqrt 3, so tau = H0 / k0 >= kappa of every perfectly plastic
-    layer (H0 >= H = 3 sigma_y) is the f = 1 law; below either hardness, or on a hardening layer, it is not."""
-    coat, sub = rigid_plastic("c", 225e6, coating=True), rigid_plastic("s", 450e6, coating=False)
-    coated = Layers(substrate=sub, coating=coat, coating_thickness_m=15e-6)
-    for H0 in (450e6, 900e6):  # at the substrate's hardness (the paper's H0 over H~ <= 1) and above
-        assert solver_interface(coated, ConstantShear(H0_Pa=H0)) == ProportionalShear(f=1.0)
-        assert solver_interface(Layers(substrate=sub), ConstantShear(H0_Pa=H0)) == ProportionalShear(f=1.0)
-    for H0 in (449e6, 300e6):  # under the substrate's hardness: the cap does not act there
-        assert solver_interface(coated, ConstantShear(H0_Pa=H0)) == ConstantShear(H0_Pa=H0)
-    # a hard coating (H~ = 2) above the constant shear
-    hard = Layers(substrate=sub, coating=rigid_plastic("c", 900e6, coating=True), coating_thickness_m=15e-6)
-    assert solver_interface(hard, ConstantShear(H0_Pa=450e6)) == ConstantShear(H0_Pa=450e6)
-    # a hardening layer: its kappa grows with strain, so no constant shear is the f = 1 law for sure
-    assert solver_interface(Layers(substrate=DX56), ConstantShear(H0_Pa=5e9)) == ConstantShear(H0_Pa=5e9)
-    for other in (ProportionalShear(f=0.5), BoundaryLayerShear(Cp=0.32, np=0.95)):
-        assert solver_interface(coated, other) is other
 
 
 def test_inertia_number_of_the_reference_scene():

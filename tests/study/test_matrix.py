@@ -11,12 +11,22 @@ import math
 import re
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 
 from plough.analytical import ploughing
-from plough.materials import ConstantShear, get_material, representative_hardness
-from plough.mpm.scene import CONTACT_MODES, Discretisation, Scene
+from plough.materials import (
+    DX56,
+    BoundaryLayerShear,
+    ConstantShear,
+    ProportionalShear,
+    get_material,
+    representative_hardness,
+    rigid_plastic,
+)
+from plough.mpm.run import simulate
+from plough.mpm.scene import CONTACT_MODES, Discretisation, Layers, Scene
 from plough.study import matrix
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -158,6 +168,57 @@ def test_shared_figures_share_runs(config):
     assert fig18_std <= set(runs_of["fig16"])
     # Fig. 23 is made of Fig. 15's and Fig. 16's runs only
     assert set(runs_of["fig23"]) <= set(runs_of["fig15"]) | set(runs_of["fig16"])
+
+
+# ----------------------------------------------------------------------------- one run for one computation
+#: a coarse coated rigid-plastic scene (h = 10 um; about 2 s a run): 450 MPa coating 15 um thick on 900 MPa
+TINY_LAYERED = {
+    "name": "tiny_layered", "load_N": 1.5, "sphere": {"radius_um": 200},
+    "layers": {"substrate": {"rigid_plastic_hardness_MPa": 900}, "coating": {"rigid_plastic_hardness_MPa": 450},
+               "coating_thickness_um": 15},
+    "domain": {"radius_um": 100, "length_um": 340, "symmetric": True},
+    "sliding": {"distance_um": 130, "speed_m_s": 0.1, "experiment_speed_m_s": 0.001},
+    "discretisation": {"particle_size_um": 10, "particles_per_cell": 2, "cfl": 0.3, "mass_scaling": 1.0e6},
+    "outputs": {"steady_window": [0.5, 1.0], "records": 40},
+}
+
+
+def test_a_constant_interface_at_or_above_every_hardness_is_the_proportional_f1_law():
+    """The solver caps tau at kappa = sigma_y / sqrt 3, so tau = H0 / k0 >= kappa of every perfectly plastic
+    layer (H0 >= H = 3 sigma_y) is the f = 1 law; below either hardness, or on a hardening layer, it is not."""
+    coat, sub = rigid_plastic("c", 225e6, coating=True), rigid_plastic("s", 450e6, coating=False)
+    coated = Layers(substrate=sub, coating=coat, coating_thickness_m=15e-6)
+    for H0 in (450e6, 900e6):  # at the substrate's hardness (the paper's H0 over H~ <= 1) and above
+        assert matrix.solver_interface(coated, ConstantShear(H0_Pa=H0)) == ProportionalShear(f=1.0)
+        assert matrix.solver_interface(Layers(substrate=sub), ConstantShear(H0_Pa=H0)) == ProportionalShear(f=1.0)
+    for H0 in (449e6, 300e6):  # under the substrate's hardness: the cap does not act there
+        assert matrix.solver_interface(coated, ConstantShear(H0_Pa=H0)) == ConstantShear(H0_Pa=H0)
+    # a hard coating (H~ = 2) above the constant shear
+    hard = Layers(substrate=sub, coating=rigid_plastic("c", 900e6, coating=True), coating_thickness_m=15e-6)
+    assert matrix.solver_interface(hard, ConstantShear(H0_Pa=450e6)) == ConstantShear(H0_Pa=450e6)
+    # a hardening layer: its kappa grows with strain, so no constant shear is the f = 1 law for sure
+    assert matrix.solver_interface(Layers(substrate=DX56), ConstantShear(H0_Pa=5e9)) == ConstantShear(H0_Pa=5e9)
+    for other in (ProportionalShear(f=0.5), BoundaryLayerShear(Cp=0.32, np=0.95)):
+        assert matrix.solver_interface(coated, other) is other
+
+
+def test_a_constant_interface_above_every_hardness_runs_as_the_proportional_f1_law():
+    """Why ``solver_interface`` may name the two laws alike (and the study make them one run): on a
+    450 MPa coating 15 um thick over the 900 MPa substrate (a particle straddling the interface mixes the two),
+    tau = 1000 MPa / k0 is capped at kappa everywhere and the run is the f = 1 run, bit for bit; at 300 MPa,
+    under the coating's hardness, it is not (mu a third lower)."""
+    runs = {}
+    for name, interface in (("f1", {"model": "proportional", "f": 1.0}),
+                            ("H0_1000", {"model": "constant", "H0_MPa": 1000}),
+                            ("H0_300", {"model": "constant", "H0_MPa": 300})):
+        scene = Scene.from_dict(TINY_LAYERED | {"interface": interface})
+        runs[name] = (scene, simulate(scene, progress=False, threads=1))
+    above, below = runs["H0_1000"][0], runs["H0_300"][0]
+    assert matrix.solver_interface(above.layers, above.interface) == runs["f1"][0].interface
+    assert matrix.solver_interface(below.layers, below.interface) == below.interface
+    for var in ("Fx", "Fz", "depth"):
+        np.testing.assert_array_equal(runs["H0_1000"][1][var].values, runs["f1"][1][var].values)
+    assert float(runs["H0_300"][1].mu) < 0.8 * float(runs["f1"][1].mu)
 
 
 def test_a_constant_interface_the_solver_caps_everywhere_shares_the_proportional_run(config):

@@ -963,26 +963,6 @@ def expected_contact(layers: Layers, load_N: float, sphere_radius_m: float) -> t
     return float(res.a), float(res.dp)
 
 
-def solver_interface(layers: Layers, interface: Interface) -> Interface:
-    """The interface law the solver runs for ``interface`` on ``layers``, in its simplest form.
-
-    The solver caps the interface shear at the contacting material's kappa = sigma_y0 / sqrt(3)
-    (``contact.interface_shear``; sigma_y0 the flow stress at rest, mixed by volume in a particle that
-    straddles the coating). Where every layer is perfectly plastic (``ConstantFlow``: sigma_y0 never
-    changes) and a constant shear tau = H0 / k0 is at or above kappa of every layer (H0 >= 3 sigma_y,
-    k0 = 3 sqrt 3), the cap acts at every node and the law is the proportional one with f = 1: returned
-    as that, so that two scenes that compute the same thing are named alike (the study makes them one
-    run). At H0 = 3 sigma_y exactly the two laws differ in round-off only (H0 / k0 against
-    sigma_y / sqrt 3). Anything else is returned unchanged: a hardening layer's kappa grows past tau.
-    """
-    if not isinstance(interface, ConstantShear):
-        return interface
-    flows = [m.flow for m in layers.materials]
-    if all(isinstance(f, ConstantFlow) and interface.H0_Pa >= 3.0 * f.sigma_y_Pa for f in flows):
-        return ProportionalShear(f=1.0)
-    return interface
-
-
 def sized_domain(layers: Layers, load_N: float, sphere_radius_m: float, slide_m: float, particle_size_m: float,
                  symmetric: bool = True, radius_contact_radii: float = 2.5,
                  end_margin_contact_radii: float = 3.0) -> Domain:
