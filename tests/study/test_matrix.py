@@ -205,19 +205,24 @@ def test_a_constant_interface_at_or_above_every_hardness_is_the_proportional_f1_
 def test_a_constant_interface_above_every_hardness_runs_as_the_proportional_f1_law():
     """Why ``solver_interface`` may name the two laws alike (and the study make them one run): on a
     450 MPa coating 15 um thick over the 900 MPa substrate (a particle straddling the interface mixes the two),
-    tau = 1000 MPa / k0 is capped at kappa everywhere and the run is the f = 1 run, bit for bit; at 300 MPa,
+    tau = 1000 MPa / k0 is capped at kappa everywhere and the run is the f = 1 run, bit for bit (at 900 MPa, the
+    substrate's hardness, to round-off); at 300 MPa,
     under the coating's hardness, it is not (mu a third lower)."""
     runs = {}
     for name, interface in (("f1", {"model": "proportional", "f": 1.0}),
                             ("H0_1000", {"model": "constant", "H0_MPa": 1000}),
+                            ("H0_900", {"model": "constant", "H0_MPa": 900}),  # = the substrate's H, the shipped case
                             ("H0_300", {"model": "constant", "H0_MPa": 300})):
         scene = Scene.from_dict(TINY_LAYERED | {"interface": interface})
         runs[name] = (scene, simulate(scene, progress=False, threads=1))
     above, below = runs["H0_1000"][0], runs["H0_300"][0]
     assert matrix.solver_interface(above.layers, above.interface) == runs["f1"][0].interface
     assert matrix.solver_interface(below.layers, below.interface) == below.interface
+    assert matrix.solver_interface(runs["H0_900"][0].layers, runs["H0_900"][0].interface) == runs["f1"][0].interface
     for var in ("Fx", "Fz", "depth"):
         np.testing.assert_array_equal(runs["H0_1000"][1][var].values, runs["f1"][1][var].values)
+        # at H0 = H the node's averaged kappa may differ from H0 / k0 by a rounding step: equal to round-off
+        np.testing.assert_allclose(runs["H0_900"][1][var].values, runs["f1"][1][var].values, rtol=1e-9, atol=0.0)
     assert float(runs["H0_300"][1].mu) < 0.8 * float(runs["f1"][1].mu)
 
 
@@ -232,14 +237,14 @@ def test_a_constant_interface_the_solver_caps_everywhere_shares_the_proportional
     a = matrix.figure_panels(config, "fig11")[0]
     const = a.series[rs["interfaces"].index("constant")].points
     prop = a.series[rs["interfaces"].index("proportional")].points
-    shared = 0
+    n_shared = 0
     for ratio, c, p in zip(rs["hardness_ratio"], const, prop, strict=True):
-        below = float(rp["H0_MPa"]) >= max(float(ratio), 1.0) * float(rs["substrate_hardness_MPa"])
-        assert (c.key == p.key) is below, (ratio, c.key)
-        assert c.interface == ({"model": "proportional", "f": 1.0} if below
+        shared = float(rp["H0_MPa"]) >= max(float(ratio), 1.0) * float(rs["substrate_hardness_MPa"])
+        assert (c.key == p.key) is shared, (ratio, c.key)
+        assert c.interface == ({"model": "proportional", "f": 1.0} if shared
                                else {"model": "constant", "H0_Pa": float(rp["H0_MPa"]) * 1e6})
         assert matrix.scene_for(c, 5.0, config["mpm"]["numerics"]).interface == (
-            matrix.scene_for(p, 5.0, config["mpm"]["numerics"]).interface if below
+            matrix.scene_for(p, 5.0, config["mpm"]["numerics"]).interface if shared
             else ConstantShear(H0_Pa=float(rp["H0_MPa"]) * 1e6))
         # the analytical model keeps the uncapped constant law (tau = H0 / k0 above the soft coating's kappa)
         direct = ploughing(float(rp["load_N"]), float(rp["radius_um"]) * 1e-6, float(rs["thickness_um"]) * 1e-6,
@@ -247,8 +252,18 @@ def test_a_constant_interface_the_solver_caps_everywhere_shares_the_proportional
                            float(rs["substrate_hardness_MPa"]) * 1e6, k1=float(rs["k1"]), interface="constant",
                            H0_Pa=float(rp["H0_MPa"]) * 1e6)
         assert matrix.analytical_values(c)["mu"] == pytest.approx(float(direct.mu), rel=1e-12)
-        shared += below
-    assert shared >= 1
+        n_shared += shared
+    assert n_shared >= 1
+    # H0 under the substrate's hardness: no constant point is shared any more, the prop1 runs stay as they were
+    lower = copy.deepcopy(config)
+    lower["mpm"]["rigid_plastic"]["H0_MPa"] = 0.9 * float(rs["substrate_hardness_MPa"])
+    before, after = matrix.all_runs(config), matrix.all_runs(lower)
+    const_lower = matrix.figure_panels(lower, "fig11")[0].series[rs["interfaces"].index("constant")].points
+    assert all(c.interface["model"] == "constant" and c.key != p.key for c, p in zip(const_lower, prop, strict=True))
+    const_runs = {matrix.run_id(c, h) for c in const_lower for h in matrix.point_ladder(lower, c).sizes_um}
+    assert const_runs <= set(after) and not const_runs & set(before)
+    assert {r for r in before if "_prop1_" in r} == {r for r in after if "_prop1_" in r}
+    assert all(before[r] == after[r] for r in before if "_prop1_" in r)
 
 
 def test_sweep_points_at_every_size_pictures_at_the_finest(config):

@@ -547,6 +547,18 @@ def test_sphere_position_reaches_the_fig12_picture(smoke_dataset):
     np.testing.assert_allclose(ds.attrs["sphere_centre_end_m_coated"], [2e-4, 0.0, 4.9e-4])
 
 
+def test_a_picture_run_under_another_law_than_configured_says_so(smoke_dataset):
+    """The smoke Fig. 12 picture (constant H0 = 450 MPa on a 225 on 450 MPa coating) is the f = 1 point's run
+    (matrix.solver_interface); its dataset keeps the configured law beside the run's scene, Fig. 14's none."""
+    pic = SMOKE["mpm"]["rigid_plastic"]["picture"]
+    assert pic["interface"] == "constant"
+    ds = smoke_dataset("fig12")
+    assert json.loads(ds.attrs["scene_coated"])["interface"] == {"model": "proportional", "f": 1.0}
+    assert json.loads(ds.attrs["interface_configured_coated"]) == {
+        "model": "constant", "H0_Pa": float(SMOKE["mpm"]["rigid_plastic"]["H0_MPa"]) * 1e6}
+    assert not any(k.startswith("interface_configured") for k in smoke_dataset("fig14").attrs)
+
+
 @pytest.mark.parametrize("figure", ["fig15", "fig19"])
 def test_result_files_from_before_the_steadiness_check_still_build(smoke_dataset, run_files, tmp_path, figure):
     """Cached runs written before io.steadiness existed have no 'steady': the figure's dataset

@@ -194,7 +194,7 @@ class Point:
     thickness_m: float
     substrate: Any  # material spec: a name or {"rigid_plastic_hardness_Pa": H}
     coating: Any | None
-    #: the interface law the MPM runs (``plough.mpm.scene.solver_interface`` of the config's law)
+    #: the interface law the MPM runs (:func:`solver_interface` of the config's law)
     interface: dict[str, Any]
     k1: float = field(default=125.0, compare=False)  # the analytical model's only: one run serves any k1
     #: the config's interface law where it differs from ``interface`` (the analytical model's only: its

@@ -15,6 +15,7 @@ Coordinates are the config's values (never float arithmetic), so datasets align 
 
 from __future__ import annotations
 
+import json
 from collections.abc import Collection, Mapping
 from pathlib import Path
 from typing import Any
@@ -246,6 +247,8 @@ def single_run_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, x
         sub.attrs = {"scene_" + label: run.attrs["scene"], "coating_representation_" + label:
                      run.attrs["coating_representation"],
                      "sphere_centre_end_m_" + label: run.attrs["sphere_centre_end_m"]}
+        if point.analytical_interface is not None:  # the run is the law the solver runs (matrix.solver_interface)
+            sub.attrs["interface_configured_" + label] = json.dumps(point.analytical_interface, sort_keys=True)
         parts.append(sub.expand_dims(case=[label]))
     ds = xr.concat(parts, dim="case", join="outer", data_vars="all", coords="different",
                    compat="equals", combine_attrs="drop_conflicts")
