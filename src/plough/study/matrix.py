@@ -205,17 +205,20 @@ class Point:
     source: dict[str, str] = field(default_factory=dict, compare=False, repr=False)
 
     def layers(self) -> Layers:
-        coating = None
-        if self.thickness_m > 0:
-            coating = material_from_spec(self.coating, coating=True, where=f"{self.key}.coating")
-        return Layers(substrate=material_from_spec(self.substrate, coating=False, where=f"{self.key}.substrate"),
-                      coating=coating, coating_thickness_m=self.thickness_m)
+        return _layers(self.substrate, self.coating, self.thickness_m, self.key)
 
     def hardnesses_Pa(self) -> tuple[float, float]:
         """(Hc, Hs) for the analytical model (Hc = Hs when uncoated)."""
         lay = self.layers()
         Hs = representative_hardness(lay.substrate)
         return (representative_hardness(lay.coating) if lay.coated else Hs), Hs
+
+
+def _layers(substrate: Any, coating: Any | None, thickness_m: float, where: str) -> Layers:
+    """The layers of material specs (``material_from_spec``); ``where`` names them in messages."""
+    coat = material_from_spec(coating, coating=True, where=f"{where}.coating") if thickness_m > 0 else None
+    return Layers(substrate=material_from_spec(substrate, coating=False, where=f"{where}.substrate"),
+                  coating=coat, coating_thickness_m=thickness_m)
 
 
 @dataclass(frozen=True)
@@ -280,11 +283,8 @@ def rigid_plastic_point(rp: dict[str, Any], ratio: float, substrate_MPa: float, 
     t = float(thickness_um)
     substrate = {"rigid_plastic_hardness_Pa": Hs * 1e6}
     coating = {"rigid_plastic_hardness_Pa": Hc * 1e6} if t > 0 else None
-    layers = Layers(substrate=material_from_spec(substrate, coating=False, where=f"{where}.substrate_hardness_MPa"),
-                    coating=None if coating is None else material_from_spec(coating, coating=True,
-                                                                             where=f"{where}.hardness_ratio"),
-                    coating_thickness_m=t * 1e-6)
     # a constant interface at or above both hardnesses runs as the proportional f = 1 law: one run for both
+    layers = _layers(substrate, coating, t * 1e-6, where)
     iface = interface_to_dict(solver_interface(layers, interface_from_dict(declared)))
     coated = f"Hc{fmt(Hc)}_Hs{fmt(Hs)}_t{fmt(t)}" if t > 0 else f"Hs{fmt(Hs)}_t0"
     key = f"rp_{coated}_{_interface_key(iface)}_r{fmt(rp['radius_um'])}_F{fmt(rp['load_N'])}"
