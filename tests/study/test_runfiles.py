@@ -31,9 +31,10 @@ def test_a_sweep_figures_view_lists_its_gated_runs_finding_them_once(monkeypatch
     runs = matrix.figure_runs(FULL, figure)
     assert len(runs) > 10
     assert len(calls) == 1  # both roles from one search (matrix.finest_run_roles)
-    gated = original(FULL)
+    finest = original(FULL)
+    gated = set(finest) - matrix._finest_runs_set_by(FULL, matrix.UNGATED_TARGETS)
     assert view["skippable"] == [r for r in runs if r in gated]
-    assert view["recordable"] == [r for r in runs if r in gated]
+    assert view["recordable"] == [r for r in runs if r in finest]
     assert view["skippable"]  # the full matrix gates some of this figure's finest runs
 
 
@@ -42,11 +43,13 @@ def test_a_sweep_figures_view_lists_its_gated_runs_finding_them_once(monkeypatch
                           (None, "stop", False, False)])
 def test_each_finest_role_follows_its_own_option(tolerance, failure, skippable, recordable):
     config = {**FULL, "mpm": {**FULL["mpm"], "skip_finest_tolerance": tolerance, "finest_failure": failure}}
-    gated = matrix.finest_sweep_runs(config)
-    assert gated
+    finest = matrix.finest_sweep_runs(config)
+    ungated = matrix._finest_runs_set_by(config, matrix.UNGATED_TARGETS)
+    gated = {rid: pair for rid, pair in finest.items() if rid not in ungated}
+    assert gated and ungated and ungated <= set(finest)
     s, r = matrix.finest_run_roles(config)
     assert s == (gated if skippable else {})
-    assert r == (gated if recordable else {})
+    assert r == (finest if recordable else {})
     assert (matrix.skippable_runs(config), matrix.failure_recordable_runs(config)) == (s, r)
 
 

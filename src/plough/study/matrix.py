@@ -64,6 +64,11 @@ LADDER_CHOICES = ("paper", "relative")
 LADDER_DEFAULT = "paper"
 #: ``mpm.ladder_targets`` of the relative ladder: particles across each length at a point's finest size
 LADDER_TARGETS = ("contact_radius_particles", "groove_depth_particles", "coating_particles")
+#: targets whose finest size refinement only where needed never stands in for (``skippable_runs``): they set it
+#: because the groove or the coating is under the target's particles at the two coarser sizes, where their
+#: two-size extrapolation of dp (and of mu, through the groove and the coating's flow) is not in the asymptotic
+#: range (docs/workflow.md, "Refinement only where needed")
+UNGATED_TARGETS = ("groove_depth_particles", "coating_particles")
 
 AXES = {
     "hardness_ratio": ("1", "coating to substrate hardness ratio H~ = Hc / Hs"),
@@ -614,7 +619,8 @@ def skippable_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
     """finest-size run id -> (coarsest, middle) run ids of the same point, for the *gated* finest runs, made
     only where the point's refinement decision asks for them (``plough.study.skipping``): empty unless
     ``mpm.skip_finest_tolerance`` is set (checked here) and there are at least three sizes; never a run a
-    picture (single-run figure) needs."""
+    picture (single-run figure) needs, nor one whose size the groove or coating target set
+    (:data:`UNGATED_TARGETS`)."""
     return finest_run_roles(config)[0]
 
 
@@ -637,7 +643,8 @@ def finest_run_roles(config: dict[str, Any]) -> tuple[dict[str, tuple[str, str]]
     if choice not in FINEST_FAILURE_CHOICES:
         raise ValueError(f"mpm.finest_failure = {choice!r} is unknown; allowed: {', '.join(FINEST_FAILURE_CHOICES)}")
     finest = finest_sweep_runs(config) if tolerance is not None or choice == "record" else {}
-    skippable = dict(finest) if tolerance is not None else {}
+    ungated = _finest_runs_set_by(config, UNGATED_TARGETS) if tolerance is not None else set()
+    skippable = {rid: pair for rid, pair in finest.items() if rid not in ungated} if tolerance is not None else {}
     recordable = dict(finest) if choice == "record" else {}
     return skippable, recordable
 
@@ -656,6 +663,16 @@ def finest_sweep_runs(config: dict[str, Any]) -> dict[str, tuple[str, str]]:
         if finest not in pictures:
             out[finest] = (run_id(p, sizes[-3]), run_id(p, sizes[-2]))
     return dict(sorted(out.items()))
+
+
+def _finest_runs_set_by(config: dict[str, Any], targets: tuple[str, ...]) -> set[str]:
+    """The finest-size run ids of the sweep points whose finest size one of ``targets`` set (``Ladder.set_by``)."""
+    out = set()
+    for p in all_points(config, SWEEP_FIGURES).values():
+        ladder = point_ladder(config, p)
+        if ladder.set_by in targets:
+            out.add(run_id(p, ladder.finest_um))
+    return out
 
 
 def analytical_values(point: Point, correction: str = "none") -> dict[str, float]:
