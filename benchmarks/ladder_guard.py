@@ -13,7 +13,8 @@ Per ladder, mu, mu_pl, mu_sh and dp are extrapolated to h -> 0 as the figures' d
 (``plough.study.extrapolation.extrapolate``: Richardson with the observed order and Roache's GCI, else the
 flagged fallbacks; from the two coarser sizes where the finest run left a failure marker), with the runs'
 sampling errors carried to the limit (``sampling_error``) in quadrature. For the relative ladder also as the
-default workflow would show it: from the two coarser sizes where its refinement decision
+default workflow would show it: from the two coarser sizes where its refinement decision, for a gated finest run
+(``plough.study.matrix.skippable_runs``),
 (``plough.study.skipping.decide`` under the config's ``mpm.skip_finest_tolerance``) would skip the finest run.
 
 The ladders agree on an output when |value_relative - value_paper| <= hypot(uncertainty_relative,
@@ -158,7 +159,7 @@ def guard(workdir: Path, relative: dict, paper: dict, key: str) -> dict:
     entry["verdicts"] = verdicts(entry["relative"]["limit"], entry["paper"]["limit"])
     # the relative ladder as the default workflow shows it: its refinement decision on the two coarser runs
     tolerance = relative["mpm"].get("skip_finest_tolerance")
-    if tolerance is not None:
+    if tolerance is not None and entry["relative"]["runs"][2] in matrix.skippable_runs(relative):
         coarse, mid = entry["relative"]["runs"][:2]
         decision = skipping.decide(entry["relative"]["runs"][2], datasets[coarse], datasets[mid], [coarse, mid],
                                    tolerance)

@@ -192,6 +192,10 @@ def test_a_finest_size_the_groove_or_coating_target_set_is_never_gated():
     assert {rid for rid, by in set_by.items() if by != "contact_radius_particles"} == set(finest) - set(skippable)
     assert {set_by[rid] for rid in set(finest) - set(skippable)} == {"groove_depth_particles", "coating_particles"}
     assert len(skippable) == 54 and set(matrix.failure_recordable_runs(CONFIG)) == set(finest)
+    assert set(finest) - set(skippable) == {  # the four 3 mm coated-steel points the groove set, two the coating
+        "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F4_h2.5", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F7_h2.5",
+        "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F11_h2.5", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F22_h5",
+        "rp_Hc900_Hs450_t2_prop1_r200_F3_h2.5", "zinc_coating-on-dx56_t10_bl0.32-0.95_r500_F22_h5"}
     seven = matrix.run_id(matrix.all_points(CONFIG)[SEVEN_N_COATED], 2.5)
     assert seven in finest and seven not in skippable
     no_groove = copy.deepcopy(CONFIG)

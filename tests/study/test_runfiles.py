@@ -36,6 +36,7 @@ def test_a_sweep_figures_view_lists_its_gated_runs_finding_them_once(monkeypatch
     assert view["skippable"] == [r for r in runs if r in gated]
     assert view["recordable"] == [r for r in runs if r in finest]
     assert view["skippable"]  # the full matrix gates some of this figure's finest runs
+    assert set(view["recordable"]) - set(view["skippable"])  # and leaves a groove- or coating-set one ungated
 
 
 @pytest.mark.parametrize(("tolerance", "failure", "skippable", "recordable"),

@@ -197,7 +197,8 @@ def test_failure_marker_carries_the_message_and_no_results():
 
 def test_failure_recordable_runs_follow_mpm_finest_failure():
     """record (the default, also when the key is absent): every finest sweep run that is not a picture's,
-    the same runs skipping may skip; stop: none; an unknown choice is refused by name."""
+    the same runs skipping may skip under the paper's ladder (the smoke matrix's); stop: none; an unknown choice
+    is refused by name."""
     with_skip = copy.deepcopy(SMOKE)
     with_skip["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
     record = copy.deepcopy(SMOKE)

@@ -269,7 +269,7 @@ def _check_not_needed(config: dict[str, Any], not_needed: Collection[str]) -> No
     if wrong:
         raise ValueError(f"run {wrong[0]!r} is named as not needed by a refinement decision, but the config does not "
                          "gate it (mpm.skip_finest_tolerance is null, fewer than three sizes, not the finest size, or "
-                         "a picture's run)")
+                         "a picture's run, or a finest size the groove or coating target set)")
 
 
 def fig22_mpm_points(config: dict[str, Any], runs: Mapping[str, xr.Dataset],
