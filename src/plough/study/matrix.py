@@ -64,10 +64,10 @@ LADDER_CHOICES = ("paper", "relative")
 LADDER_DEFAULT = "paper"
 #: ``mpm.ladder_targets`` of the relative ladder: particles across each length at a point's finest size
 LADDER_TARGETS = ("contact_radius_particles", "groove_depth_particles", "coating_particles")
-#: targets whose finest size refinement only where needed never stands in for (``skippable_runs``): they set it
-#: because the groove or the coating is under the target's particles at the two coarser sizes, where their
-#: two-size extrapolation of dp (and of mu, through the groove and the coating's flow) is not in the asymptotic
-#: range (docs/workflow.md, "Refinement only where needed")
+#: targets whose finest size refinement only where needed never stands in for (``skippable_runs``): such a target
+#: added that size because it judged the two sizes above it too coarse for the groove or the coating, so letting
+#: those two stand in would undo it; where the contact target asks for the same size (a tie) the contact's gate
+#: applies (docs/workflow.md, "Refinement only where needed")
 UNGATED_TARGETS = ("groove_depth_particles", "coating_particles")
 
 AXES = {
