@@ -178,10 +178,10 @@ SEVEN_N_COATED = "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F7"
 
 
 def test_a_finest_size_the_groove_or_coating_target_set_is_never_gated():
-    """Refinement only where needed stands in for a finest run only where the contact target set its size: the
-    groove and coating targets set it because dp or t is under their particles at the two coarser sizes, where
-    the two-size extrapolation is not in the asymptotic range (docs/workflow.md: at the 3 mm ball on coated
-    steel at 7 N the 2.5 um run moved mu by -4.4% and dp by +25% from 5 um, outside the two-size bars). Such a
+    """Refinement only where needed stands in for a finest run only where the contact target set its size
+    (the contact first where targets tie): a groove or coating target added that size because it judged the two
+    above it too coarse (docs/workflow.md: at the 3 mm ball on coated steel at 7 N the 2.5 um run moved mu by
+    -4.4% and dp by +25% from 5 um, the finest run 1.5 and 1.7 of the two-size bars from that limit). Such a
     run may still leave a failure marker; with the groove target dropped the 7 N point is the contact's again
     and gated; under the paper's ladder every finest sweep run is gated."""
     finest = matrix.finest_sweep_runs(CONFIG)

@@ -14,8 +14,8 @@ two coarser sizes, flagged ``TWO_SIZES_ASSUMED_ORDER`` (``CONVERGED``, not flagg
 agree exactly), and the finest run is never scheduled. Otherwise the datasets need the finest run
 and Snakemake makes it. Pictures (the single-run figures) always use a real finest run: their runs
 are never gated; nor is a finest size the relative ladder's groove or coating target set
-(``plough.study.matrix.UNGATED_TARGETS``): there the groove or the coating is under a particle at the two
-coarser sizes, whose extrapolation is then not to be trusted. The tolerance is one number for every
+(``plough.study.matrix.UNGATED_TARGETS``): such a target added that size because it judged the two sizes
+above it too coarse for the groove or the coating, so they do not stand in for it. The tolerance is one number for every
 checked output or one per output (:func:`tolerances`).
 
 Default off (``null``): every size runs (the paper's ladder, ``config/paper.yaml``).
