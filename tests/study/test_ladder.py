@@ -61,29 +61,38 @@ def test_paper_yaml_is_config_yaml_with_the_papers_ladder():
     of every point runs (no refinement only where needed)."""
     paper, same = _load("paper"), copy.deepcopy(CONFIG)
     same["mpm"]["ladder"] = "paper"
-    del same["mpm"]["ladder_targets"]
+    del same["mpm"]["ladder_targets"], same["mpm"]["ladder_sizes_per_octave"]
     assert CONFIG["mpm"]["skip_finest_tolerance"] is not None  # on by default
     same["mpm"]["skip_finest_tolerance"] = None
     assert paper == same
 
 
+@pytest.mark.parametrize("per_octave", [1, 2])
 @pytest.mark.parametrize("targets", [
     {"contact_radius_particles": 12, "groove_depth_particles": 1, "coating_particles": 1.5},
     {"contact_radius_particles": 9, "groove_depth_particles": None, "coating_particles": None},
     {"contact_radius_particles": 20, "groove_depth_particles": 3, "coating_particles": 4},
 ])
-def test_the_relative_ladder_is_the_coarsest_that_meets_its_targets(targets):
+def test_the_relative_ladder_is_the_coarsest_that_meets_its_targets(targets, per_octave):
+    """Each point's finest size is the coarsest of the sizes it may take (the config's 2.5 um times a power of
+    two; with two sizes an octave also 3.5 um times one) at which its targets hold, and its sizes keep the
+    config's ratios."""
     config = _relative(targets)
+    config["mpm"]["ladder_sizes_per_octave"] = per_octave
     paper = matrix.particle_sizes_um(config)
     finest_paper = paper[-1]
+    allowed = sorted(b * 2.0 ** k for k in range(-4, 8) for b in ((2.5,) if per_octave == 1 else (2.5, 3.5)))
     na, nd, nt = (targets[k] for k in matrix.LADDER_TARGETS)
+    finest_sizes = set()
     for p in matrix.all_points(config).values():
         lad = matrix.point_ladder(config, p)
         a, dp, t = _lengths_um(p)
         assert lad.contact_radius_um == pytest.approx(a) and lad.groove_depth_um == pytest.approx(dp)
-        k = math.log2(lad.scale)
-        assert k.is_integer() and lad.sizes_um == tuple(h * lad.scale for h in paper), p.key
         h = lad.finest_um
+        assert any(h == pytest.approx(size, rel=1e-12) for size in allowed), (p.key, h)
+        assert lad.sizes_um == pytest.approx(tuple(x * h / finest_paper for x in paper), rel=1e-12), p.key
+        assert lad.scale == pytest.approx(h / finest_paper, rel=1e-12)
+        finest_sizes.add(h)
 
         def meets(size: float, a: float = a, dp: float = dp, t: float = t) -> bool:
             """The targets at a finest size; groove and coating down to the config's finest size only."""
@@ -95,9 +104,28 @@ def test_the_relative_ladder_is_the_coarsest_that_meets_its_targets(targets):
             return ok
 
         assert meets(h), (p.key, lad)
-        assert not meets(2 * h), (p.key, lad)  # the coarsest that does
+        assert not meets(min(size for size in allowed if size > h * (1 + 1e-9))), (p.key, lad)  # the coarsest
         if nd is not None and h < finest_paper * (1 - 1e-9):
             assert dp / h >= nd or lad.set_by == "contact_radius_particles"
+    assert (per_octave == 2) == any(math.log2(h / 3.5).is_integer() for h in finest_sizes)  # both kinds taken
+
+
+def test_half_octave_sizes_are_exact_and_a_bad_choice_is_refused():
+    """The half-octave size of 2.5 um is 3.5 um (sqrt(2) x 2.5 to two digits), and a point's sizes are written
+    as their ids spell them (no 14.000000000000002); any other ladder_sizes_per_octave is refused by the schema
+    and by the matrix, naming the key, the value and the allowed values."""
+    assert matrix._half_octave_um(2.5) == 3.5 and matrix._half_octave_um(10.0) == 14.0
+    ladders = [matrix.point_ladder(CONFIG, p) for p in matrix.all_points(CONFIG).values()]
+    assert any(lad.finest_um in (1.75, 3.5, 7.0, 14.0) for lad in ladders)
+    for lad in ladders:
+        assert all(float(matrix.fmt(h)) == h for h in lad.sizes_um), lad
+    validator = jsonschema.Draft202012Validator(SCHEMA)
+    for bad in (3, 0, True, 1.5):
+        config = copy.deepcopy(CONFIG)
+        config["mpm"]["ladder_sizes_per_octave"] = bad
+        assert list(validator.iter_errors(config)), bad
+        with pytest.raises(ValueError, match=r"mpm.ladder_sizes_per_octave = .* allowed: 1, 2"):
+            matrix.all_runs(config)
 
 
 #: the five accuracy-guard points of issue 34 (benchmarks/ladder_guard.py; docs/workflow.md, *The ladder*)
@@ -128,8 +156,8 @@ def test_a_paper_budget_keeps_the_papers_sizes_where_they_are_cheap():
         else:
             assert lad == without, key
         if key in GUARD_POINTS:
-            assert without.scale == 2.0 and lad.set_by == "paper_budget", key
-    assert kept == 11
+            assert without.scale > 1.0 and lad.set_by == "paper_budget", key
+    assert kept == 22
     assert set(GUARD_POINTS) <= set(matrix.all_points(config))
     for bad in (0, -1.0, "many"):
         config["mpm"]["ladder_paper_budget_particle_steps"] = bad
@@ -191,17 +219,23 @@ def test_a_finest_size_the_groove_or_coating_target_set_is_never_gated():
     set_by = {rid: matrix.point_ladder(CONFIG, points[rid]).set_by for rid in finest}
     assert {rid for rid, by in set_by.items() if by != "contact_radius_particles"} == set(finest) - set(skippable)
     assert {set_by[rid] for rid in set(finest) - set(skippable)} == {"groove_depth_particles", "coating_particles"}
-    assert len(skippable) == 54 and set(matrix.failure_recordable_runs(CONFIG)) == set(finest)
-    assert set(finest) - set(skippable) == {  # the four 3 mm coated-steel points the groove set, two the coating
+    assert len(skippable) == 45 and set(matrix.failure_recordable_runs(CONFIG)) == set(finest)
+    assert set(finest) - set(skippable) == {  # the groove set eight, the coating seven
+        "dx56_bl1.34-0.88_r500_F4_h2.5", "zinc_bulk_bl0.32-0.95_r500_F4_h2.5",
+        "rp_Hc450_Hs900_t4_prop1_r200_F3_h2.5", "rp_Hc900_Hs450_t4_prop1_r200_F3_h2.5",
         "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F4_h2.5", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F7_h2.5",
-        "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F11_h2.5", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F22_h5",
-        "rp_Hc900_Hs450_t2_prop1_r200_F3_h2.5", "zinc_coating-on-dx56_t10_bl0.32-0.95_r500_F22_h5"}
+        "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F11_h3.5", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F22_h7",
+        "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F37_h10", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F46_h10",
+        "zinc_coating-on-dx56_t15_bl0.32-0.95_r500_F37_h10", "zinc_coating-on-dx56_t15_bl0.32-0.95_r500_F46_h10",
+        "rp_Hc450_Hs900_t2_prop1_r200_F3_h2.5", "rp_Hc900_Hs450_t2_prop1_r200_F3_h2.5",
+        "zinc_coating-on-dx56_t10_bl0.32-0.95_r500_F22_h5"}
     seven = matrix.run_id(matrix.all_points(CONFIG)[SEVEN_N_COATED], 2.5)
     assert seven in finest and seven not in skippable
     no_groove = copy.deepcopy(CONFIG)
     no_groove["mpm"]["ladder_targets"]["groove_depth_particles"] = None
-    seven_coarse = matrix.run_id(matrix.all_points(no_groove)[SEVEN_N_COATED], 5.0)
-    assert seven_coarse in matrix.skippable_runs(no_groove)
+    seven_point = matrix.all_points(no_groove)[SEVEN_N_COATED]
+    seven_coarse = matrix.point_ladder(no_groove, seven_point).finest_um
+    assert seven_coarse > 2.5 and matrix.run_id(seven_point, seven_coarse) in matrix.skippable_runs(no_groove)
     paper = _load("paper")
     paper["mpm"]["skip_finest_tolerance"] = {"mu": 0.05, "dp": 0.3}
     assert matrix.skippable_runs(paper) == matrix.finest_sweep_runs(paper) != {}

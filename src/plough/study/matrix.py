@@ -64,6 +64,11 @@ LADDER_CHOICES = ("paper", "relative")
 LADDER_DEFAULT = "paper"
 #: ``mpm.ladder_targets`` of the relative ladder: particles across each length at a point's finest size
 LADDER_TARGETS = ("contact_radius_particles", "groove_depth_particles", "coating_particles")
+#: ``mpm.ladder_sizes_per_octave`` of the relative ladder: 1 = a point's sizes are the paper's times 2^k; 2 = also
+#: times 2^k x the paper's finest size x sqrt(2) rounded to two digits (3.5 um for 2.5): a finest size within a
+#: factor 1.43, not 2, of the coarsest that meets the targets (docs/workflow.md, "The ladder")
+LADDER_SIZES_PER_OCTAVE_CHOICES = (1, 2)
+LADDER_SIZES_PER_OCTAVE_DEFAULT = 2
 #: targets whose finest size refinement only where needed never stands in for (``skippable_runs``): such a target
 #: added that size because it judged the two sizes above it too coarse for the groove or the coating, so letting
 #: those two stand in would undo it; where the contact target asks for the same size (a tie) the contact's gate
@@ -390,7 +395,7 @@ def figure_points(config: dict[str, Any], figure: str) -> dict[str, Point]:
 
 def particle_sizes_um(config: dict[str, Any]) -> tuple[float, ...]:
     """The config's particle sizes ``mpm.particle_sizes_um``, descending: the paper's ladder, which every
-    point runs with ``mpm.ladder: paper`` and which the relative ladder scales by a power of two per point
+    point runs with ``mpm.ladder: paper`` and which the relative ladder scales per point
     (:func:`point_ladder`). A point's own sizes: ``point_ladder(config, point).sizes_um``."""
     return tuple(sorted((float(h) for h in config["mpm"]["particle_sizes_um"]), reverse=True))
 
@@ -400,7 +405,8 @@ class Ladder:
     """The particle sizes of one point (descending, um) and the length scales they were chosen from (um)."""
 
     sizes_um: tuple[float, ...]
-    #: sizes_um = the config's particle_sizes_um x scale; scale = 2^k (1 for the paper's ladder)
+    #: sizes_um = the config's particle_sizes_um x scale; scale = 2^k, or (half-octave size / finest) x 2^k with
+    #: ``ladder_sizes_per_octave: 2`` (1 for the paper's ladder)
     scale: float
     contact_radius_um: float  # the analytical model's expected contact radius a
     groove_depth_um: float  # its ploughing depth dp
@@ -426,6 +432,22 @@ def _exponent(length_um: float, target: float, finest_um: float) -> int:
     return math.floor(math.log2(length_um / (target * finest_um)) + 1e-9)
 
 
+def _half_octave_um(finest_um: float) -> float:
+    """The size between ``finest_um`` and twice it: ``finest_um`` x sqrt(2) to two significant digits (3.5 for
+    2.5), so that its run ids stay short and its multiples by powers of two exact."""
+    return float(f"{finest_um * math.sqrt(2.0):.2g}")
+
+
+def _scale(length_um: float, target: float, finest_um: float, per_octave: int, floor: bool) -> float:
+    """The largest scale s with ``length / (finest s) >= target``, s = 2^k, or with ``per_octave`` 2 also
+    (half-octave size / finest) x 2^k; ``floor``: never below 1 (the groove and coating targets)."""
+    scale = 2.0 ** _exponent(length_um, target, finest_um)
+    if per_octave == 2:
+        half = _half_octave_um(finest_um)
+        scale = max(scale, half / finest_um * 2.0 ** _exponent(length_um, target, half))
+    return max(scale, 1.0) if floor else scale
+
+
 @cache
 def _expected_contact_um(layers: Layers, load_N: float, radius_m: float) -> tuple[float, float]:
     """(a, dp) in um of the analytical model (``plough.mpm.scene.expected_contact``), computed once per
@@ -436,20 +458,25 @@ def _expected_contact_um(layers: Layers, load_N: float, radius_m: float) -> tupl
 
 def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     """The particle sizes of ``point``: ``mpm.ladder: paper`` (the default) runs every point at the config's
-    ``particle_sizes_um``; ``relative`` runs it at those sizes times 2^k, k the largest integer at which the
-    finest size holds ``mpm.ladder_targets`` particles across the point's own lengths:
+    ``particle_sizes_um``; ``relative`` runs it at those sizes times a scale, the largest at which the finest
+    size holds ``mpm.ladder_targets`` particles across the point's own lengths:
 
     * ``contact_radius_particles`` across the expected contact radius a (``plough.mpm.scene.expected_contact``,
       the analytical model): the contact patch and the plastic zone under it, which set mu; it may take the
-      point below the config's finest size (k < 0);
+      point below the config's finest size (scale < 1);
     * ``groove_depth_particles`` across the expected ploughing depth dp: the groove and its rims (dp);
     * ``coating_particles`` across the coating thickness t (coated points): the coating's own flow, which
       sets the layered system's hardness.
 
-    The groove and coating targets never take a point below the config's finest size (k >= 0 for them):
-    where the paper's own ladder leaves a groove or a thin coating under a particle, so does this one.
-    ``null`` leaves a target out. Sizes are the config's times a power of two, so a run shared by both
-    ladders is one run (its id names its size).
+    The scales a point may take (``mpm.ladder_sizes_per_octave``): 1, a power of two, so that a finest size
+    lies within a factor 2 of the coarsest one meeting the targets; 2 (the default), also the half-octave
+    size (the config's finest x sqrt(2) to two digits, 3.5 um for 2.5) over the finest times a power of two,
+    within a factor 1.43: the targets bound the error, and a finest size up to twice as fine as they need
+    costs up to 16x the particle-steps (particles x steps go as h^-4). The groove and coating targets never
+    take a point below the config's finest size (scale >= 1 for them): where the paper's own ladder leaves a
+    groove or a thin coating under a particle, so does this one. ``null`` leaves a target out. A point's
+    sizes keep the ratios of the config's, and a run shared by both ladders is one run (its id names its
+    size).
 
     ``mpm.ladder_paper_budget_particle_steps`` (null: none): a point the targets would coarsen (k > 0) keeps
     the paper's sizes if they cost at most this many particle-steps together (:func:`paper_ladder_particle_steps`):
@@ -468,19 +495,26 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     if not isinstance(targets, dict) or targets.get("contact_radius_particles") is None:
         raise ValueError("mpm.ladder = relative needs mpm.ladder_targets with contact_radius_particles (> 0); "
                          f"optional: {', '.join(LADDER_TARGETS[1:])} (null: not a target)")
+    per_octave = mpm.get("ladder_sizes_per_octave", LADDER_SIZES_PER_OCTAVE_DEFAULT)
+    if per_octave not in LADDER_SIZES_PER_OCTAVE_CHOICES or isinstance(per_octave, bool):
+        raise ValueError(f"mpm.ladder_sizes_per_octave = {per_octave!r} is not allowed; allowed: "
+                         f"{', '.join(map(str, LADDER_SIZES_PER_OCTAVE_CHOICES))}")
     finest = paper[-1]
-    bounds = {"contact_radius_particles": _exponent(a, float(targets["contact_radius_particles"]), finest)}
+    scales = {"contact_radius_particles": _scale(a, float(targets["contact_radius_particles"]), finest, per_octave,
+                                                 floor=False)}
     if targets.get("groove_depth_particles") is not None:
-        bounds["groove_depth_particles"] = max(0, _exponent(dp, float(targets["groove_depth_particles"]), finest))
+        scales["groove_depth_particles"] = _scale(dp, float(targets["groove_depth_particles"]), finest, per_octave,
+                                                  floor=True)
     if targets.get("coating_particles") is not None and t > 0:
-        bounds["coating_particles"] = max(0, _exponent(t, float(targets["coating_particles"]), finest))
-    set_by = min(bounds, key=lambda name: bounds[name])  # the first of equals: the contact before the others
+        scales["coating_particles"] = _scale(t, float(targets["coating_particles"]), finest, per_octave, floor=True)
+    set_by = min(scales, key=lambda name: scales[name])  # the first of equals: the contact before the others
     budget = mpm.get("ladder_paper_budget_particle_steps")
-    if (bounds[set_by] > 0 and budget is not None
+    if (scales[set_by] > 1.0 and budget is not None
             and paper_ladder_particle_steps(point, paper, mpm["numerics"]) <= float(budget)):
         return Ladder(paper, 1.0, a, dp, t, "paper_budget")
-    scale = 2.0 ** bounds[set_by]
-    return Ladder(tuple(h * scale for h in paper), scale, a, dp, t, set_by)
+    scale = scales[set_by]
+    # to twelve digits: 10 x 1.4 is 14.000000000000002 in binary, and a run's size is its id's (fmt)
+    return Ladder(tuple(float(f"{h * scale:.12g}") for h in paper), scale, a, dp, t, set_by)
 
 
 def paper_ladder_particle_steps(point: Point, sizes_um: tuple[float, ...], numerics: dict[str, Any]) -> float:

@@ -83,7 +83,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
         panel.axis: ((panel.axis,), np.asarray(panel.values, dtype=float), {"units": ax_units, "long_name": ax_long}),
         "h": (("h",), np.asarray(sizes_um, dtype=float), {"units": "um", "long_name": "particle size h", **(
             {"comment": "the sizes of mpm.particle_sizes_um; each point's own (mpm.ladder: relative) are "
-                        "particle_size_um, these times a power of two: its extrapolation is the same"}
+                        "particle_size_um, these times a scale: its extrapolation is the same"}
             if ladders else {})}),
     }
     shape = (len(labels), len(panel.values), len(sizes_um))
@@ -167,7 +167,7 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                                                  **({"allow_missing": 1} if two_sizes.any() else {})})
     if ladders:  # mpm.ladder: relative: each point at its own sizes
         out[f"particle_size_um{suffix}"] = (dims3, size, {"units": "um", "long_name": "the run's particle size "
-                                                          "(the point's own ladder: h times a power of two)"})
+                                                          "(the point's own ladder: h times a scale)"})
     if np.isfinite(steady).any():  # result files written before the check carry none
         out[f"steady{suffix}"] = (dims3, steady, {"units": "1", "allow_missing": 1,
                                                   "long_name": STEADINESS_META["steady"][1] + " (per run; missing: "
@@ -208,7 +208,7 @@ def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dat
     _check_not_needed(config, not_needed)
     recordable = set(matrix.failure_recordable_runs(config))
     # each point's own sizes (mpm.ladder: relative); the h -> 0 extrapolation runs along the config's sizes,
-    # which a point's are times a power of two: Richardson, the GCI, the least-squares fallback and the sampling
+    # which a point's are times a scale (the same ratios): Richardson, the GCI, the least-squares fallback and the sampling
     # errors' weights depend on the sizes' ratios only, so the values and uncertainties are those of its own
     ladders = {pt.key: matrix.point_ladder(config, pt).sizes_um for p in panels for s in p.series for pt in s.points}
     parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", set(not_needed), recordable,

@@ -407,7 +407,10 @@ def describe(plan: Plan, *, points: bool = False) -> str:
     sizes = ", ".join(f"{h:g}" for h in matrix.particle_sizes_um(plan.config))
     if ladder == "relative":
         targets = ", ".join(f"{k} {v:g}" for k, v in mpm["ladder_targets"].items() if v is not None)
-        lines.append(f"ladder: relative (each point's sizes: {sizes} um times a power of two; targets at its finest "
+        per_octave = mpm.get("ladder_sizes_per_octave", matrix.LADDER_SIZES_PER_OCTAVE_DEFAULT)
+        scales = "a power of two" if per_octave == 1 else (
+            f"2^k or {matrix._half_octave_um(matrix.particle_sizes_um(plan.config)[-1]) / matrix.particle_sizes_um(plan.config)[-1]:g} x 2^k")
+        lines.append(f"ladder: relative (each point's sizes: {sizes} um times {scales}; targets at its finest "
                      f"size: {targets})")
     else:
         lines.append(f"ladder: paper ({sizes} um for every point)")
