@@ -114,7 +114,7 @@ def test_half_octave_sizes_are_exact_and_a_bad_choice_is_refused():
     """The half-octave size of 2.5 um is 3.5 um (sqrt(2) x 2.5 to two digits), and a point's sizes are written
     as their ids spell them (no 14.000000000000002); any other ladder_sizes_per_octave is refused by the schema
     and by the matrix, naming the key, the value and the allowed values."""
-    assert matrix._half_octave_um(2.5) == 3.5 and matrix._half_octave_um(10.0) == 14.0
+    assert matrix.half_octave_um(2.5) == 3.5 and matrix.half_octave_um(10.0) == 14.0
     ladders = [matrix.point_ladder(CONFIG, p) for p in matrix.all_points(CONFIG).values()]
     assert any(lad.finest_um in (1.75, 3.5, 7.0, 14.0) for lad in ladders)
     for lad in ladders:

@@ -432,7 +432,7 @@ def _exponent(length_um: float, target: float, finest_um: float) -> int:
     return math.floor(math.log2(length_um / (target * finest_um)) + 1e-9)
 
 
-def _half_octave_um(finest_um: float) -> float:
+def half_octave_um(finest_um: float) -> float:
     """The size between ``finest_um`` and twice it: ``finest_um`` x sqrt(2) to two significant digits (3.5 for
     2.5), so that its run ids stay short and its multiples by powers of two exact."""
     return float(f"{finest_um * math.sqrt(2.0):.2g}")
@@ -443,7 +443,7 @@ def _scale(length_um: float, target: float, finest_um: float, per_octave: int, f
     (half-octave size / finest) x 2^k; ``floor``: never below 1 (the groove and coating targets)."""
     scale = 2.0 ** _exponent(length_um, target, finest_um)
     if per_octave == 2:
-        half = _half_octave_um(finest_um)
+        half = half_octave_um(finest_um)
         scale = max(scale, half / finest_um * 2.0 ** _exponent(length_um, target, half))
     return max(scale, 1.0) if floor else scale
 

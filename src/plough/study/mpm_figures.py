@@ -208,8 +208,8 @@ def sweep_dataset(config: dict[str, Any], figure: str, runs: Mapping[str, xr.Dat
     _check_not_needed(config, not_needed)
     recordable = set(matrix.failure_recordable_runs(config))
     # each point's own sizes (mpm.ladder: relative); the h -> 0 extrapolation runs along the config's sizes,
-    # which a point's are times a scale (the same ratios): Richardson, the GCI, the least-squares fallback and the sampling
-    # errors' weights depend on the sizes' ratios only, so the values and uncertainties are those of its own
+    # which a point's are times a scale (the same ratios): Richardson, the GCI, the least-squares fallback and the
+    # sampling errors' weights depend on the sizes' ratios only, so the values and uncertainties are those of its own
     ladders = {pt.key: matrix.point_ladder(config, pt).sizes_um for p in panels for s in p.series for pt in s.points}
     parts = [_panel_dataset(p, sizes, runs, f"_{p.name}" if len(panels) > 1 else "", set(not_needed), recordable,
                             ladders if any(lad != sizes for lad in ladders.values()) else None)
