@@ -220,7 +220,7 @@ def test_a_finest_size_the_groove_or_coating_target_set_is_never_gated():
     assert {rid for rid, by in set_by.items() if by != "contact_radius_particles"} == set(finest) - set(skippable)
     assert {set_by[rid] for rid in set(finest) - set(skippable)} == {"groove_depth_particles", "coating_particles"}
     assert len(skippable) == 45 and set(matrix.failure_recordable_runs(CONFIG)) == set(finest)
-    assert set(finest) - set(skippable) == {  # the groove set eight, the coating seven
+    assert set(finest) - set(skippable) == {  # the groove set seven, the coating eight
         "dx56_bl1.34-0.88_r500_F4_h2.5", "zinc_bulk_bl0.32-0.95_r500_F4_h2.5",
         "rp_Hc450_Hs900_t4_prop1_r200_F3_h2.5", "rp_Hc900_Hs450_t4_prop1_r200_F3_h2.5",
         "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F4_h2.5", "zinc_coating-on-dx56_t15_bl0.32-0.95_r1500_F7_h2.5",

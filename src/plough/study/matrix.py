@@ -478,7 +478,7 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     sizes keep the ratios of the config's, and a run shared by both ladders is one run (its id names its
     size).
 
-    ``mpm.ladder_paper_budget_particle_steps`` (null: none): a point the targets would coarsen (k > 0) keeps
+    ``mpm.ladder_paper_budget_particle_steps`` (null: none): a point the targets would coarsen (scale > 1) keeps
     the paper's sizes if they cost at most this many particle-steps together (:func:`paper_ladder_particle_steps`):
     where the paper's ladder is cheap the relative one saves little and its coarsest size, a contact radius of
     3-5 particles, widens the extrapolation's uncertainty (docs/workflow.md, *The ladder*)."""
