@@ -119,6 +119,12 @@ def test_half_octave_sizes_are_exact_and_a_bad_choice_is_refused():
     assert any(lad.finest_um in (1.75, 3.5, 7.0, 14.0) for lad in ladders)
     for lad in ladders:
         assert all(float(matrix.fmt(h)) == h for h in lad.sizes_um), lad
+    fine = copy.deepcopy(CONFIG)  # a finest size of 1.25 um: half-octave 1.8, whose products are not all exact
+    fine["mpm"]["particle_sizes_um"] = [5, 2.5, 1.25]
+    fine_ladders = [matrix.point_ladder(fine, p) for p in matrix.all_points(fine).values()]
+    assert any(lad.finest_um in (0.9, 1.8, 3.6, 7.2, 14.4) for lad in fine_ladders)
+    for lad in fine_ladders:
+        assert all(float(matrix.fmt(h)) == h for h in lad.sizes_um), lad
     validator = jsonschema.Draft202012Validator(SCHEMA)
     for bad in (3, 0, True, 1.5):
         config = copy.deepcopy(CONFIG)

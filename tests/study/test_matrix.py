@@ -526,5 +526,6 @@ def test_preview_config_is_the_full_matrix_at_two_coarser_sizes():
     runs_full, runs_preview = matrix.all_runs(full), matrix.all_runs(preview)
     shared = set(runs_full) & set(runs_preview)
     ladders = [matrix.point_ladder(full, p).sizes_um for p in matrix.all_points(full).values()]
-    assert len(shared) == sum((20.0 in s) + (10.0 in s) for s in ladders) > 0
+    # a third, not half, since the half-octave sizes (14, 28 um ...) share nothing with the preview's
+    assert len(shared) == sum((20.0 in s) + (10.0 in s) for s in ladders) > len(runs_preview) // 3
     assert all(runs_full[rid] == runs_preview[rid] for rid in shared)

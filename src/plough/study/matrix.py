@@ -513,7 +513,8 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
             and paper_ladder_particle_steps(point, paper, mpm["numerics"]) <= float(budget)):
         return Ladder(paper, 1.0, a, dp, t, "paper_budget")
     scale = scales[set_by]
-    # to twelve digits: 10 x 1.4 is 14.000000000000002 in binary, and a run's size is its id's (fmt)
+    # to twelve digits: a scaled size is not always exact in binary (5 x (1.8 / 1.25) x 2 is 14.399999999999999
+    # for a config of 5, 2.5, 1.25 um), and a run's size is what its id (fmt) spells
     return Ladder(tuple(float(f"{h * scale:.12g}") for h in paper), scale, a, dp, t, set_by)
 
 
