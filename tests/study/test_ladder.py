@@ -111,9 +111,10 @@ def test_the_relative_ladder_is_the_coarsest_that_meets_its_targets(targets, per
 
 
 def test_half_octave_sizes_are_exact_and_a_bad_choice_is_refused():
-    """The half-octave size of 2.5 um is 3.5 um (sqrt(2) x 2.5 to two digits), and a point's sizes are written
-    as their ids spell them (no 14.000000000000002); any other ladder_sizes_per_octave is refused by the schema
-    and by the matrix, naming the key, the value and the allowed values."""
+    """The half-octave size of 2.5 um is 3.5 um (sqrt(2) x 2.5 to two digits), and a point's sizes are what their
+    ids spell, also where a scaled size is not exact in binary (a config of 5, 2.5, 1.25 um: 14.399999999999999
+    unrounded); any other ladder_sizes_per_octave is refused by the schema and by the matrix, naming the key, the
+    value and the allowed values."""
     assert matrix.half_octave_um(2.5) == 3.5 and matrix.half_octave_um(10.0) == 14.0
     ladders = [matrix.point_ladder(CONFIG, p) for p in matrix.all_points(CONFIG).values()]
     assert any(lad.finest_um in (1.75, 3.5, 7.0, 14.0) for lad in ladders)
