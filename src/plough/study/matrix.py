@@ -438,13 +438,21 @@ def half_octave_um(finest_um: float) -> float:
     return float(f"{finest_um * math.sqrt(2.0):.2g}")
 
 
-def _scale(length_um: float, target: float, finest_um: float, per_octave: int, floor: bool) -> float:
-    """The largest scale s with ``length / (finest s) >= target``, s = 2^k, or with ``per_octave`` 2 also
-    (half-octave size / finest) x 2^k; ``floor``: never below 1 (the groove and coating targets)."""
-    scale = 2.0 ** _exponent(length_um, target, finest_um)
-    if per_octave == 2:
-        half = half_octave_um(finest_um)
-        scale = max(scale, half / finest_um * 2.0 ** _exponent(length_um, target, half))
+def ladder_bases_um(config: dict[str, Any]) -> tuple[float, ...]:
+    """The sizes whose multiples by a power of two a relative ladder's finest size may be: the config's finest
+    size, and with ``mpm.ladder_sizes_per_octave: 2`` (the default) also its half-octave size (checked here)."""
+    per_octave = config["mpm"].get("ladder_sizes_per_octave", LADDER_SIZES_PER_OCTAVE_DEFAULT)
+    if per_octave not in LADDER_SIZES_PER_OCTAVE_CHOICES or isinstance(per_octave, bool):
+        raise ValueError(f"mpm.ladder_sizes_per_octave = {per_octave!r} is not allowed; allowed: "
+                         f"{', '.join(map(str, LADDER_SIZES_PER_OCTAVE_CHOICES))}")
+    finest = particle_sizes_um(config)[-1]
+    return (finest,) if per_octave == 1 else (finest, half_octave_um(finest))
+
+
+def _scale(length_um: float, target: float, bases_um: tuple[float, ...], floor: bool) -> float:
+    """The largest scale s, (base / the first base) x 2^k over ``bases_um``, with ``length / (bases_um[0] s) >=
+    target``; ``floor``: never below 1 (the groove and coating targets)."""
+    scale = max(base / bases_um[0] * 2.0 ** _exponent(length_um, target, base) for base in bases_um)
     return max(scale, 1.0) if floor else scale
 
 
@@ -495,18 +503,12 @@ def point_ladder(config: dict[str, Any], point: Point) -> Ladder:
     if not isinstance(targets, dict) or targets.get("contact_radius_particles") is None:
         raise ValueError("mpm.ladder = relative needs mpm.ladder_targets with contact_radius_particles (> 0); "
                          f"optional: {', '.join(LADDER_TARGETS[1:])} (null: not a target)")
-    per_octave = mpm.get("ladder_sizes_per_octave", LADDER_SIZES_PER_OCTAVE_DEFAULT)
-    if per_octave not in LADDER_SIZES_PER_OCTAVE_CHOICES or isinstance(per_octave, bool):
-        raise ValueError(f"mpm.ladder_sizes_per_octave = {per_octave!r} is not allowed; allowed: "
-                         f"{', '.join(map(str, LADDER_SIZES_PER_OCTAVE_CHOICES))}")
-    finest = paper[-1]
-    scales = {"contact_radius_particles": _scale(a, float(targets["contact_radius_particles"]), finest, per_octave,
-                                                 floor=False)}
+    bases = ladder_bases_um(config)
+    scales = {"contact_radius_particles": _scale(a, float(targets["contact_radius_particles"]), bases, floor=False)}
     if targets.get("groove_depth_particles") is not None:
-        scales["groove_depth_particles"] = _scale(dp, float(targets["groove_depth_particles"]), finest, per_octave,
-                                                  floor=True)
+        scales["groove_depth_particles"] = _scale(dp, float(targets["groove_depth_particles"]), bases, floor=True)
     if targets.get("coating_particles") is not None and t > 0:
-        scales["coating_particles"] = _scale(t, float(targets["coating_particles"]), finest, per_octave, floor=True)
+        scales["coating_particles"] = _scale(t, float(targets["coating_particles"]), bases, floor=True)
     set_by = min(scales, key=lambda name: scales[name])  # the first of equals: the contact before the others
     budget = mpm.get("ladder_paper_budget_particle_steps")
     if (scales[set_by] > 1.0 and budget is not None

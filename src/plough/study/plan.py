@@ -407,9 +407,8 @@ def describe(plan: Plan, *, points: bool = False) -> str:
     sizes = ", ".join(f"{h:g}" for h in matrix.particle_sizes_um(plan.config))
     if ladder == "relative":
         targets = ", ".join(f"{k} {v:g}" for k, v in mpm["ladder_targets"].items() if v is not None)
-        per_octave = mpm.get("ladder_sizes_per_octave", matrix.LADDER_SIZES_PER_OCTAVE_DEFAULT)
-        finest = matrix.particle_sizes_um(plan.config)[-1]
-        scales = "a power of two" if per_octave == 1 else f"2^k or {matrix.half_octave_um(finest) / finest:g} x 2^k"
+        finest, *half = matrix.ladder_bases_um(plan.config)
+        scales = " or ".join(["2^k", *(f"{h / finest:g} x 2^k" for h in half)])
         lines.append(f"ladder: relative (each point's sizes: {sizes} um times {scales}; targets at its finest "
                      f"size: {targets})")
     else:
