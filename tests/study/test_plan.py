@@ -218,6 +218,20 @@ def test_plough_plan_prints_every_figure_and_the_total(capsys, tmp_path):
     assert main(["plan", "--directory", str(tmp_path), "--cores", "0"]) == 2
 
 
+def test_the_plan_names_the_finest_sizes_the_relative_ladder_may_take(tmp_path):
+    """The ladder line states the sizes a point's finest run may take: 2.5 or 3.5 um x 2^k with half-octaves (the
+    default), 2.5 um x 2^k with octaves only."""
+    from plough.study.plan import describe
+
+    config = load_config([], ROOT)
+    assert config["mpm"]["ladder"] == "relative" and config["mpm"]["ladder_sizes_per_octave"] == 2
+    first = describe(make_plan(config, directory=tmp_path)).splitlines()[0]
+    assert "um times 2^k or 1.4 x 2^k, a finest size of 2.5 or 3.5 um x 2^k; targets" in first
+    config["mpm"]["ladder_sizes_per_octave"] = 1
+    first = describe(make_plan(config, directory=tmp_path)).splitlines()[0]
+    assert "um times 2^k, a finest size of 2.5 um x 2^k; targets" in first
+
+
 def test_the_plan_leaves_out_what_is_made_and_expects_the_share_of_decisions_that_needed_their_run(tmp_path):
     """A run counts as made where its result file records its scene and this solver (a failure marker included,
     an old skip marker not); what is left is stated as a range and, once decisions are made, as an expected time

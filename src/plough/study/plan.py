@@ -409,8 +409,9 @@ def describe(plan: Plan, *, points: bool = False) -> str:
         targets = ", ".join(f"{k} {v:g}" for k, v in mpm["ladder_targets"].items() if v is not None)
         finest, *half = matrix.ladder_bases_um(plan.config)
         scales = " or ".join(["2^k", *(f"{h / finest:g} x 2^k" for h in half)])
-        lines.append(f"ladder: relative (each point's sizes: {sizes} um times {scales}; targets at its finest "
-                     f"size: {targets})")
+        finests = " or ".join(f"{h:g}" for h in (finest, *half))
+        lines.append(f"ladder: relative (each point's sizes: {sizes} um times {scales}, a finest size of {finests} um "
+                     f"x 2^k; targets at its finest size: {targets})")
     else:
         lines.append(f"ladder: paper ({sizes} um for every point)")
     sources = sorted({r.source for r in plan.measured})
