@@ -9,7 +9,7 @@ skip marker, the projection of
 ``benchmarks/reproduction_time.py`` (particle-steps from ``plough.study.cost`` over the measured
 throughput, with the graded, active-zone and real-material factors) is set beside it. Prints the
 totals and the ratio measured / projected by particle size, family and material system (median, range). Writes the
-per-run rows to ``--out`` (default benchmarks/results/projection_check.json).
+per-run rows, each with when its job ended (``ended``), to ``--out`` (default benchmarks/results/projection_check.json).
 """
 
 from __future__ import annotations
@@ -26,7 +26,7 @@ from reproduction_time import ROOT, add_measured_arguments, project_run, through
 
 from plough.mpm.scene import Scene
 from plough.study import matrix
-from plough.study.plan import is_marker, job_seconds
+from plough.study.plan import ended_at, is_marker, job_seconds
 
 
 def result_attrs(result: Path) -> dict:
@@ -65,6 +65,9 @@ def main() -> None:
                      "particles": c.particles,
                      "particle_steps": c.particle_steps, "projected_s": projected,
                      "measured_s": job_seconds(tsv),
+                     # when the job ended (its benchmark file's time): plough plan counts a run measured in
+                     # several files at its latest row
+                     "ended": ended_at(tsv).isoformat(timespec="seconds"),
                      # the run's own wall time (press and slide, without the job's start-up and writing), NaN
                      # for a missing file; the threads it ran at, the config's for that
                      "simulate_s": float(attrs.get("cost_wall_time_s", math.nan)),

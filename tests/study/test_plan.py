@@ -8,8 +8,10 @@ from __future__ import annotations
 
 import copy
 import json
+import os
 import subprocess
 import sys
+from datetime import UTC, datetime
 from pathlib import Path
 
 import pytest
@@ -24,6 +26,7 @@ from plough.study.plan import (
     Measured,
     Rates,
     _hours,
+    family_of,
     load_config,
     make_plan,
     measured_from_benchmarks,
@@ -83,6 +86,51 @@ def test_jobs_at_the_configs_threads_set_the_rate_where_measured():
     assert rates.scaled == {("real materials", 10), ("real materials", 40)}
 
 
+def test_a_run_measured_more_than_once_counts_at_its_latest_end(tmp_path):
+    """Calibration files need not sort by name in the order they were measured: a run in several files counts at
+    the row whose job ended last; rows from before the end was recorded count as older than any that records it,
+    and among themselves in file-name order."""
+    row = {"family": "rigid-plastic", "h_um": 10.0, "particle_steps": 1e9}
+    files = {"a_old.json": [{**row, "run": "r", "measured_s": 100.0}, {**row, "run": "s", "measured_s": 100.0}],
+             "b_undated.json": [{**row, "run": "s", "measured_s": 200.0}],
+             "c_late.json": [{**row, "run": "r", "measured_s": 400.0, "ended": "2026-12-06T17:10:09+00:00"}],
+             "d_early.json": [{**row, "run": "r", "measured_s": 800.0, "ended": "2026-12-05T09:00:00Z"}]}
+    for name, runs in files.items():
+        (tmp_path / name).write_text(json.dumps({"threads": 2, "runs": runs}))
+    rows = measured_from_json(sorted(tmp_path.glob("*.json")))
+    # oldest first: the undated rows in file-name order, then d_early ("Z" read as UTC), then c_late
+    assert [(Path(r.source).stem, r.run) for r in rows] == [("a_old", "r"), ("a_old", "s"), ("b_undated", "s"),
+                                                            ("d_early", "r"), ("c_late", "r")]
+    assert rows[3].ended == datetime(2026, 12, 5, 9, tzinfo=UTC)
+    rates = Rates.from_measured(rows, threads=2)
+    # r: c_late's 400 s (ended last), not d_early's, which sorts after it by name; s: b_undated's, the later file
+    assert rates.rate("rigid-plastic", 10) == pytest.approx(2e9 / (400 + 200))
+    assert rates.by_family["rigid-plastic"][10][0] == 2
+    (tmp_path / "e_bad.json").write_text(json.dumps({"runs": [{**row, "run": "t", "measured_s": 1.0,
+                                                               "ended": "2026-12-06 17:10"}]}))
+    with pytest.raises(ValueError, match=r"e_bad.json: run 't': ended = '2026-12-06 17:10' has no time zone"):
+        measured_from_json([tmp_path / "e_bad.json"])
+
+
+def test_this_machines_benchmark_files_outrank_the_calibration_files(tmp_path):
+    """A run with a benchmark file under the workflow's directory counts at it, though a calibration file (say one
+    pulled later) measured the run after it: plough plan projects this machine from its own jobs first."""
+    runs = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(SMOKE).items()}
+    rid = sorted(runs)[0]
+    family, h = family_of(runs[rid]), round(runs[rid].discretisation.particle_size_m * 1e6, 6)
+    steps = cost.estimate(runs[rid]).particle_steps
+    (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
+    (tmp_path / "results" / "runs").mkdir(parents=True)
+    (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text("s\th:m:s\tmax_rss\n12.5\t0:00:12\t100\n")
+    os.utime(tmp_path / "benchmarks" / "runs" / f"{rid}.tsv", (0.0, 0.0))  # 1970: older than any calibration row
+    xr.Dataset(attrs={"cost_particle_steps": 1, "cost_threads": 1, "scene": to_json(runs[rid].to_dict())}).to_netcdf(
+        tmp_path / "results" / "runs" / f"{rid}.nc")
+    calib = _calibration(tmp_path, [{"run": rid, "family": family, "h_um": h, "particle_steps": steps,
+                                     "measured_s": 99.0, "threads": 1, "ended": "2026-12-06T17:10:09Z"}])
+    plan = make_plan(SMOKE, directory=tmp_path, calibration=[calib])
+    assert plan.rates.by_family[family][h] == (1, pytest.approx(steps / 12.5 * SMOKE["mpm"]["threads"]))
+
+
 def _calibration(tmp_path: Path, rows: list[dict]) -> Path:
     path = tmp_path / "projection_check_test.json"
     path.write_text(json.dumps({"config": "none.yaml", "runs": rows}))
@@ -137,11 +185,13 @@ def test_benchmark_files_of_the_configs_runs_calibrate_markers_do_not(tmp_path):
     (tmp_path / "results" / "runs").mkdir(parents=True)
     for rid, seconds in ((made, 12.5), (marker, 0.4), (stranger, 99.0)):
         (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
+    ended = datetime(2026, 12, 6, 17, 10, 9, tzinfo=UTC)
+    os.utime(tmp_path / "benchmarks" / "runs" / f"{made}.tsv", (ended.timestamp(), ended.timestamp()))
     xr.Dataset(attrs={"cost_particle_steps": 1, "cost_threads": 1, "scene": to_json(runs[made].to_dict())}).to_netcdf(
         tmp_path / "results" / "runs" / f"{made}.nc")
     xr.Dataset(attrs={"skipped_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
     rows = measured_from_benchmarks(tmp_path, runs, threads=2)
-    assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 1)]
+    assert [(r.run, r.seconds, r.threads, r.ended) for r in rows] == [(made, 12.5, 1, ended)]
     assert rows[0].particle_steps == cost.estimate(runs[made]).particle_steps
 
 
@@ -155,6 +205,8 @@ def test_projection_check_rows_are_runs_not_markers(tmp_path):
     (tmp_path / "results" / "runs").mkdir(parents=True)
     for rid, seconds in ((made, 12.5), (marker, 0.4)):
         (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
+    ended = datetime(2026, 12, 6, 17, 10, 9, tzinfo=UTC)
+    os.utime(tmp_path / "benchmarks" / "runs" / f"{made}.tsv", (ended.timestamp(), ended.timestamp()))
     xr.Dataset(attrs={"cost_wall_time_s": 11.0, "cost_threads": 2}).to_netcdf(
         tmp_path / "results" / "runs" / f"{made}.nc")
     xr.Dataset(attrs={"failed_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
@@ -163,7 +215,7 @@ def test_projection_check_rows_are_runs_not_markers(tmp_path):
                     "--config", str(ROOT / "config" / "smoke.yaml"), "--out", str(out)],
                    check=True, capture_output=True, cwd=ROOT)
     rows = measured_from_json([out])
-    assert [(r.run, r.seconds, r.threads) for r in rows] == [(made, 12.5, 2)]
+    assert [(r.run, r.seconds, r.threads, r.ended) for r in rows] == [(made, 12.5, 2, ended)]
     assert rows[0].particle_steps == pytest.approx(cost.estimate(runs[made]).particle_steps)
 
 

@@ -17,6 +17,9 @@ a job's start-up, its result's writing and the fixed cost of a step are in it. T
   runs measured here, at the threads each row or file records, 2 where neither says), where no benchmark
   file of the same run is present.
 
+A run measured more than once counts once: at its benchmark file here, else at the row whose job ended last
+(rows without the time, from files written before it was recorded, count as older, in file-name order).
+
 Where jobs of a family and size were measured at the config's threads, only they set its rate. Elsewhere jobs
 measured at other thread counts are scaled linearly: optimistic for more threads a run (a run gains 1.6-1.8x
 from a second thread here), pessimistic for fewer (two one-thread runs at once beat one two-thread run by
@@ -49,6 +52,7 @@ import json
 import math
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass, field
+from datetime import UTC, datetime
 from pathlib import Path
 from typing import Any
 
@@ -87,7 +91,9 @@ def load_config(configfiles: Iterable[str | Path], directory: str | Path = ".") 
 
 @dataclass(frozen=True)
 class Measured:
-    """One measured workflow job: its run, family, size, counted particle-steps, wall time and threads."""
+    """One measured workflow job: its run, family, size, counted particle-steps, wall time, threads, where it was
+    read and when the job ended (``None`` where that was not recorded: calibration files written before 2026-12-06
+    evening)."""
 
     run: str
     family: str
@@ -96,6 +102,26 @@ class Measured:
     seconds: float
     threads: int
     source: str
+    ended: datetime | None = None
+
+
+def ended_at(tsv: Path) -> datetime:
+    """When a Snakemake benchmark file was written, the end of its job: the file's modification time, in UTC."""
+    return datetime.fromtimestamp(tsv.stat().st_mtime, UTC)
+
+
+def _ended(row: Mapping[str, Any], path: Path) -> datetime | None:
+    """A calibration row's ``ended`` (ISO 8601 with its time zone), ``None`` where the row has none."""
+    text = row.get("ended")
+    if text is None:
+        return None
+    try:
+        when = datetime.fromisoformat(text)
+    except (TypeError, ValueError):
+        raise ValueError(f"{path}: run {row.get('run')!r}: ended = {text!r} is not an ISO 8601 time") from None
+    if when.tzinfo is None:
+        raise ValueError(f"{path}: run {row.get('run')!r}: ended = {text!r} has no time zone (write it in UTC, Z)")
+    return when
 
 
 def family_of(scene: Any) -> str:
@@ -114,7 +140,9 @@ UNRECORDED_THREADS = 2
 
 def measured_from_json(paths: Iterable[Path]) -> list[Measured]:
     """The rows of ``projection_check.py`` results, each at the threads it records (``threads`` of the row, else
-    of the file, else ``UNRECORDED_THREADS``)."""
+    of the file, else ``UNRECORDED_THREADS``), oldest first: the rows that record when their job ended in the
+    order of their end, after those that do not (written before it was recorded), which keep the order of
+    their files' names."""
     rows = []
     for path in sorted(paths):
         data = json.loads(path.read_text())
@@ -122,8 +150,10 @@ def measured_from_json(paths: Iterable[Path]) -> list[Measured]:
         for r in data["runs"]:
             if math.isfinite(r.get("measured_s", math.nan)) and r["measured_s"] > 0:
                 rows.append(Measured(r["run"], r["family"], float(r["h_um"]), float(r["particle_steps"]),
-                                     float(r["measured_s"]), int(r.get("threads", threads)), str(path)))
-    return rows
+                                     float(r["measured_s"]), int(r.get("threads", threads)), str(path),
+                                     _ended(r, path)))
+    undated = [r for r in rows if r.ended is None]
+    return undated + sorted((r for r in rows if r.ended is not None), key=lambda r: r.ended)
 
 
 def job_seconds(tsv: Path) -> float:
@@ -166,7 +196,7 @@ def measured_from_benchmarks(directory: Path, runs: Mapping[str, Any], threads: 
         scene = runs[rid]
         rows.append(Measured(rid, family_of(scene), round(scene.discretisation.particle_size_m * 1e6, 6),
                              cost.estimate(scene).particle_steps, seconds, int(attrs.get("cost_threads", threads)),
-                             str(tsv)))
+                             str(tsv), ended_at(tsv)))
     return rows
 
 
