@@ -24,7 +24,8 @@ difference; a flagged limit (fallback or two sizes, Fs = 3) has a wide uncertain
 missing sampling error is counted as none (``sampling_error_missing``). The issue's other target: the relative
 ladder's uncertainty of mu no larger than the paper's.
 
-Writes ``--out`` (one entry per point: the sizes, each run's values, sampling errors, steadiness and wall time,
+Writes ``--out`` (the provenance with the solver's fingerprint, which every run read was checked against; one
+entry per point: the sizes, each run's values, sampling errors, steadiness and wall time,
 each ladder's extrapolations, the verdicts; JSON without NaN: an undefined number is null) and prints a table. A
 point whose runs are not all there is reported as such.
 """
@@ -206,7 +207,9 @@ def main() -> None:
             only_relative = [r for r in lad["relative"]["runs"] if r not in lad["paper"]["runs"]]
             make_runs(args.workdir, args.relative, only_relative, args.cores)
     entries = [guard(args.workdir, relative, paper, key) for key in args.points]
-    result = {"provenance": provenance_attrs(), "relative_config": str(args.relative), "paper_config": str(args.paper),
+    # every run was read checked against this solver: its fingerprint says which solver the numbers belong to
+    result = {"provenance": provenance_attrs() | {"solver_fingerprint": solver_fingerprint()},
+              "relative_config": str(args.relative), "paper_config": str(args.paper),
               "points": entries}
     args.out.parent.mkdir(parents=True, exist_ok=True)
     args.out.write_text(json.dumps(result, indent=1, allow_nan=False))

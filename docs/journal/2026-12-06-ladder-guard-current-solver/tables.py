@@ -16,7 +16,8 @@ def fmt(x: float | None, scale: float = 1.0, digits: int = 4) -> str:
 
 def main(path: Path) -> None:
     data = json.loads(path.read_text())
-    print(f"solver commit {data['provenance']['git_commit'][:7]}\n")
+    prov = data["provenance"]
+    print(f"tree {prov['git_commit'][:7]}, solver fingerprint {prov.get('solver_fingerprint', 'not recorded')}\n")
     for p in data["points"]:
         print(f"### {p['point']}\n")
         print("| run | mu (SE) | mu_pl | mu_sh | dp (um) | steady | wall (s) |")
