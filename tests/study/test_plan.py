@@ -86,6 +86,19 @@ def test_jobs_at_the_configs_threads_set_the_rate_where_measured():
     assert rates.scaled == {("real materials", 10), ("real materials", 40)}
 
 
+def _benchmark_file(directory: Path, rid: str, seconds: float, ended: datetime | None = None) -> None:
+    """A Snakemake benchmark file of a run's job under ``directory``, written (its time set) at ``ended``."""
+    tsv = directory / "benchmarks" / "runs" / f"{rid}.tsv"
+    tsv.parent.mkdir(parents=True, exist_ok=True)
+    tsv.write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
+    if ended is not None:
+        os.utime(tsv, (ended.timestamp(), ended.timestamp()))
+
+
+#: when the made-up jobs of the benchmark-file tests ended
+ENDED = datetime(2026, 12, 6, 17, 10, 9, tzinfo=UTC)
+
+
 def test_a_run_measured_more_than_once_counts_at_its_latest_end(tmp_path):
     """Calibration files need not sort by name in the order they were measured: a run in several files counts at
     the row whose job ended last; rows from before the end was recorded count as older than any that records it,
@@ -119,10 +132,8 @@ def test_this_machines_benchmark_files_outrank_the_calibration_files(tmp_path):
     rid = sorted(runs)[0]
     family, h = family_of(runs[rid]), round(runs[rid].discretisation.particle_size_m * 1e6, 6)
     steps = cost.estimate(runs[rid]).particle_steps
-    (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
     (tmp_path / "results" / "runs").mkdir(parents=True)
-    (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text("s\th:m:s\tmax_rss\n12.5\t0:00:12\t100\n")
-    os.utime(tmp_path / "benchmarks" / "runs" / f"{rid}.tsv", (0.0, 0.0))  # 1970: older than any calibration row
+    _benchmark_file(tmp_path, rid, 12.5, ended=datetime(1970, 1, 1, tzinfo=UTC))  # older than any calibration row
     xr.Dataset(attrs={"cost_particle_steps": 1, "cost_threads": 1, "scene": to_json(runs[rid].to_dict())}).to_netcdf(
         tmp_path / "results" / "runs" / f"{rid}.nc")
     calib = _calibration(tmp_path, [{"run": rid, "family": family, "h_um": h, "particle_steps": steps,
@@ -181,17 +192,14 @@ def test_the_plan_of_a_config_from_measured_jobs(tmp_path):
 def test_benchmark_files_of_the_configs_runs_calibrate_markers_do_not(tmp_path):
     runs = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(SMOKE).items()}
     made, marker, stranger = sorted(runs)[:2] + ["not_a_run_h10"]
-    (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
     (tmp_path / "results" / "runs").mkdir(parents=True)
     for rid, seconds in ((made, 12.5), (marker, 0.4), (stranger, 99.0)):
-        (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
-    ended = datetime(2026, 12, 6, 17, 10, 9, tzinfo=UTC)
-    os.utime(tmp_path / "benchmarks" / "runs" / f"{made}.tsv", (ended.timestamp(), ended.timestamp()))
+        _benchmark_file(tmp_path, rid, seconds, ENDED if rid == made else None)
     xr.Dataset(attrs={"cost_particle_steps": 1, "cost_threads": 1, "scene": to_json(runs[made].to_dict())}).to_netcdf(
         tmp_path / "results" / "runs" / f"{made}.nc")
     xr.Dataset(attrs={"skipped_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
     rows = measured_from_benchmarks(tmp_path, runs, threads=2)
-    assert [(r.run, r.seconds, r.threads, r.ended) for r in rows] == [(made, 12.5, 1, ended)]
+    assert [(r.run, r.seconds, r.threads, r.ended) for r in rows] == [(made, 12.5, 1, ENDED)]
     assert rows[0].particle_steps == cost.estimate(runs[made]).particle_steps
 
 
@@ -201,12 +209,9 @@ def test_projection_check_rows_are_runs_not_markers(tmp_path):
     are those its result records, not the config's (smoke: 1)."""
     runs = {rid: Scene.from_dict(s) for rid, s in matrix.all_runs(SMOKE).items()}
     made, marker = sorted(runs)[:2]
-    (tmp_path / "benchmarks" / "runs").mkdir(parents=True)
     (tmp_path / "results" / "runs").mkdir(parents=True)
     for rid, seconds in ((made, 12.5), (marker, 0.4)):
-        (tmp_path / "benchmarks" / "runs" / f"{rid}.tsv").write_text(f"s\th:m:s\tmax_rss\n{seconds}\t0:00:12\t100\n")
-    ended = datetime(2026, 12, 6, 17, 10, 9, tzinfo=UTC)
-    os.utime(tmp_path / "benchmarks" / "runs" / f"{made}.tsv", (ended.timestamp(), ended.timestamp()))
+        _benchmark_file(tmp_path, rid, seconds, ENDED if rid == made else None)
     xr.Dataset(attrs={"cost_wall_time_s": 11.0, "cost_threads": 2}).to_netcdf(
         tmp_path / "results" / "runs" / f"{made}.nc")
     xr.Dataset(attrs={"failed_finest_size": 1}).to_netcdf(tmp_path / "results" / "runs" / f"{marker}.nc")
@@ -215,7 +220,7 @@ def test_projection_check_rows_are_runs_not_markers(tmp_path):
                     "--config", str(ROOT / "config" / "smoke.yaml"), "--out", str(out)],
                    check=True, capture_output=True, cwd=ROOT)
     rows = measured_from_json([out])
-    assert [(r.run, r.seconds, r.threads, r.ended) for r in rows] == [(made, 12.5, 2, ended)]
+    assert [(r.run, r.seconds, r.threads, r.ended) for r in rows] == [(made, 12.5, 2, ENDED)]
     assert rows[0].particle_steps == pytest.approx(cost.estimate(runs[made]).particle_steps)
 
 

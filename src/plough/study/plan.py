@@ -115,12 +115,13 @@ def _ended(row: Mapping[str, Any], path: Path) -> datetime | None:
     text = row.get("ended")
     if text is None:
         return None
+    where = f"{path}: run {row.get('run')!r}: ended = {text!r}"
     try:
         when = datetime.fromisoformat(text)
     except (TypeError, ValueError):
-        raise ValueError(f"{path}: run {row.get('run')!r}: ended = {text!r} is not an ISO 8601 time") from None
+        raise ValueError(f"{where} is not an ISO 8601 time") from None
     if when.tzinfo is None:
-        raise ValueError(f"{path}: run {row.get('run')!r}: ended = {text!r} has no time zone (write it in UTC, Z)")
+        raise ValueError(f"{where} has no time zone (write it in UTC, Z)")
     return when
 
 
