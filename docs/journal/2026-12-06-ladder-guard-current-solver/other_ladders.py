@@ -2,8 +2,9 @@
 
     python docs/journal/2026-12-06-ladder-guard-current-solver/other_ladders.py /work/guardrun
 
-Reads the point's run files (28, 20, 14, 10, 7, 5, 2.5 µm; the 20 µm one made with config/preview.yaml), each checked
-against its scene and this tree's solver, and extrapolates mu as benchmarks/ladder_guard.py does (its ``limit``).
+Reads the point's run files (28, 20, 14, 10, 7, 5, 3.5, 2.5 µm; the 20 µm one made with config/preview.yaml, the
+3.5 µm one with contact20.yaml beside this file), each checked against its scene and this tree's solver, and
+extrapolates mu as benchmarks/ladder_guard.py does (its ``limit``).
 """
 
 from __future__ import annotations
@@ -28,8 +29,10 @@ KEY = "zinc_bulk_bl0.32-0.95_r500_F11"
 
 def main(workdir: Path) -> None:
     scenes: dict = {}
-    for name in ("config.yaml", "paper.yaml", "preview.yaml"):
-        scenes |= matrix.all_runs(load_config([ROOT / "config" / name], ROOT))
+    config = ROOT / "config"
+    for files in ([config / "config.yaml"], [config / "paper.yaml"], [config / "preview.yaml"],
+                  [config / "config.yaml", Path(__file__).parent / "contact20.yaml"]):
+        scenes |= matrix.all_runs(load_config(files, ROOT))
     solver = solver_fingerprint()
     runs = {}
     for rid, scene in scenes.items():
