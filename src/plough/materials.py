@@ -239,16 +239,29 @@ class ConstantShear:
         return self.H0_Pa / K0
 
 
+#: where the MPM reads the boundary layer's local contact pressure P (docs/model.md, section 3.7)
+BOUNDARY_LAYER_PRESSURES = ("particles", "traction")
+
+
 @dataclass(frozen=True)
 class BoundaryLayerShear:
-    """tau = Cp * P^np with P the contact pressure in Pa (eq. 8.3, Table 5)."""
+    """tau = Cp * P^np with P the contact pressure in Pa (eq. 8.3, Table 5).
+
+    ``pressure`` says where the MPM's grid contact reads the local P at a contact node: ``particles`` (the
+    default), -n . sigma . n of the node's particles, mass-averaged; ``traction``, the normal traction the
+    sphere puts on the node (its normal impulse over its surface share and the step), averaged over the
+    contact's hold. The analytical model always takes the nominal Fn / Axy.
+    """
 
     Cp: float
     np: float
+    pressure: str = "particles"
 
     def __post_init__(self) -> None:
         _check_positive("BoundaryLayerShear", Cp=self.Cp)
         _check_range("BoundaryLayerShear", "np", self.np, 0.0, 1.0)
+        if self.pressure not in BOUNDARY_LAYER_PRESSURES:
+            raise ValueError(f"interface.pressure = {self.pressure!r} is not one of {list(BOUNDARY_LAYER_PRESSURES)}")
 
 
 Interface = ProportionalShear | ConstantShear | BoundaryLayerShear

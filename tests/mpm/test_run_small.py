@@ -1104,3 +1104,18 @@ def test_a_particle_contact_run_writes_no_grid_split_and_no_nan():
         if np.issubdtype(var.dtype, np.floating) and not var.attrs.get("allow_missing"):
             assert np.isfinite(var.values).all(), name
     assert float(ds.mu_sh) > 0.0
+
+
+def test_the_traction_boundary_layer_integrates_to_cp_times_the_load():
+    """With ``interface.pressure: traction`` and np = 1 the law's strength summed over the contact,
+    sum Cp P_i A_i, is Cp times the normal force the contact nodes carry (P_i A_i is a node's normal force,
+    averaged over the hold): at least Cp Fz, a few per cent more for the tilt of the nodes' normals on a
+    shallow contact. Cp = 0.02 keeps tau far below kappa, so the cap does not bind. The particles' stress
+    (the default) reads less than half of that pressure next to the sphere, so reading it would fail here."""
+    Cp = 0.02
+    d = scene_dict(interface={"model": "boundary_layer", "Cp": Cp, "np": 1.0, "pressure": "traction"})
+    ds = simulate(Scene.from_dict(d), progress=False, threads=1)
+    w = ds.in_steady_window.values.astype(bool)
+    ratio = ds.contact_shear_capacity.values[w].mean() / (Cp * ds.Fz.values[w].mean())
+    assert 0.98 <= ratio <= 1.12
+    assert float(ds.mu_sh) == pytest.approx(Cp * ratio, rel=0.05)  # every node slides: the strength is the force

@@ -258,6 +258,19 @@ def test_unknown_or_missing_interface_key_is_a_value_error(interface):
         Scene.from_dict(_mutate(interface=interface))
 
 
+def test_the_boundary_layer_pressure_is_named_and_needs_the_grid_contact():
+    d = _mutate(interface={"model": "boundary_layer", "Cp": 0.32, "np": 0.95})
+    assert Scene.from_dict(d).interface.pressure == "particles"  # the default
+    d["interface"]["pressure"] = "nodes"
+    with pytest.raises(ValueError, match=r"interface\.pressure = 'nodes' is not one of \['particles', 'traction'\]"):
+        Scene.from_dict(d)
+    d["interface"]["pressure"] = "traction"
+    assert Scene.from_dict(d).interface.pressure == "traction"
+    d["discretisation"] = {**d.get("discretisation", {}), "contact": "particle"}
+    with pytest.raises(ValueError, match=r"interface\.pressure = 'traction' needs discretisation\.contact"):
+        Scene.from_dict(d)
+
+
 def test_a_coating_without_its_thickness_is_refused_not_dropped():
     d = example_dict("coated_rigid_plastic")
     del d["layers"]["coating_thickness_um"]

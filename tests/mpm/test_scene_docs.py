@@ -233,8 +233,10 @@ def test_the_reader_accepts_the_documented_default(row):
         given, plain = {"layers": MINIMAL_LAYERS, segs[0][0]: value}, {"layers": MINIMAL_LAYERS}
     elif segs[0][0] == "interface":
         model = segs[0][1]
-        given = {"layers": MINIMAL_LAYERS, "interface": {"model": model, segs[1][0]: value}}
-        plain = {"layers": MINIMAL_LAYERS, "interface": {"model": model}}
+        # the model's required keys (Table 5's zinc lubricant for the boundary layer), so only the optional one differs
+        required = {"boundary_layer": {"Cp": 0.32, "np": 0.95}}.get(model, {})
+        given = {"layers": MINIMAL_LAYERS, "interface": {"model": model, **required, segs[1][0]: value}}
+        plain = {"layers": MINIMAL_LAYERS, "interface": {"model": model, **required}}
     elif segs[0][0] == "layers":
         given = {"layers": dict(MINIMAL_LAYERS) | {segs[1][0]: value}}
         plain = {"layers": MINIMAL_LAYERS}

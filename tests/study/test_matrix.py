@@ -312,9 +312,11 @@ def _steel_runs(runs: dict) -> set[str]:
 @pytest.mark.parametrize(("path", "value", "affected"), [
     (("real_materials", "lubricants", "dx56", "Cp"), 1.5, "steel"),
     (("real_materials", "lubricants", "zinc", "np"), 0.9, "zinc"),
+    # the pressure the MPM reads: the default's ids carry no name for it, the traction runs are new ids
+    (("real_materials", "lubricants", "zinc", "pressure"), "traction", "zinc"),
     # 500 MPa, above 450: the constant points at H~ <= 1 stay the f = 1 law (test above), the others change
     (("rigid_plastic", "H0_MPa"), 500, "constant"),
-], ids=["lubricant_dx56_Cp", "lubricant_zinc_np", "H0_MPa"])
+], ids=["lubricant_dx56_Cp", "lubricant_zinc_np", "lubricant_zinc_pressure", "H0_MPa"])
 def test_changing_a_parameter_changes_exactly_the_runs_that_use_it(config, runs, path, value, affected):
     changed_config = copy.deepcopy(config)
     node = changed_config["mpm"]
@@ -328,7 +330,8 @@ def test_changing_a_parameter_changes_exactly_the_runs_that_use_it(config, runs,
     elif affected == "zinc":  # every run with the zinc lubricant: coated steel and the zinc block
         zinc = config["mpm"]["real_materials"]["lubricants"]["zinc"]
         users = {rid for rid, d in runs.items()
-                 if d["interface"] == {"model": "boundary_layer", "Cp": zinc["Cp"], "np": zinc["np"]}}
+                 if d["interface"] == {"model": "boundary_layer", "Cp": zinc["Cp"], "np": zinc["np"],
+                                       "pressure": "particles"}}
     else:
         users = {rid for rid, d in runs.items() if d["interface"]["model"] == "constant"}
     assert users and len(users) < len(runs)
@@ -338,18 +341,21 @@ def test_changing_a_parameter_changes_exactly_the_runs_that_use_it(config, runs,
     # the others are the same runs with the new parameter, under new ids (the key spells the interface)
     new = set(after) - set(runs)
     assert len(new) == len(users) and len(after) == len(runs)
-    field = {"Cp": "Cp", "np": "np", "H0_MPa": "H0_Pa"}[path[-1]]
-    scale = 1e6 if field == "H0_Pa" else 1.0
+    field = {"Cp": "Cp", "np": "np", "pressure": "pressure", "H0_MPa": "H0_Pa"}[path[-1]]
+    scale = 1e6 if field == "H0_Pa" else 1
     by_rest = {}
     for rid in users:
         d = copy.deepcopy(runs[rid])
         d.pop("name")
-        d["interface"][field] = value * scale
+        d["interface"][field] = value * scale if field != "pressure" else value
         by_rest[repr(d)] = rid
     for rid in new:
         d = copy.deepcopy(after[rid])
         d.pop("name")
         assert repr(d) in by_rest, rid  # nothing but the parameter differs
+    if field == "pressure":  # the default's ids name no pressure; the new ones do
+        assert all("_bl" in rid and "-traction_" not in rid for rid in users)
+        assert all("-traction_" in rid for rid in new)
 
 
 def test_k1_changes_no_run_but_the_analytical_values(config, runs):

@@ -24,7 +24,10 @@ next to it: an error of order dx along the contact's perimeter. The interface sh
     proportional:    tau = f * kappa                 (kappa = sigma_y / sqrt(3) of the material)
     constant:        tau = H0 / k0
     boundary layer:  tau = Cp * P^np                 (P in Pa, Table 5; P = -n . sigma . n of the
-                                                      node's particles, mass-averaged)
+                                                      node's particles, mass-averaged, or with
+                                                      ``interface.pressure: traction`` the node's
+                                                      normal traction averaged over the hold:
+                                                      held_traction)
 
 always capped at kappa (never above the contacting material's shear strength) and never larger
 than the impulse that stops the slip (so the slip never reverses). The reaction on the sphere
@@ -56,6 +59,8 @@ from plough.mpm.shape import bspline2_grad, stencil, stencil_node
 from plough.mpm.transfers import mirror_partner
 
 INTERFACE_PROPORTIONAL, INTERFACE_CONSTANT, INTERFACE_BOUNDARY_LAYER = 0, 1, 2
+#: the boundary layer with P the node's normal traction (``interface.pressure: traction``), not its particles' stress
+INTERFACE_BOUNDARY_LAYER_TRACTION = 3
 SQRT3 = math.sqrt(3.0)
 #: a node stays in contact this many elastic-wave transits of a cell (dx / c) after its last normal push
 HOLD_WAVE_TIMES = 2.0
@@ -92,9 +97,11 @@ N_OUT = 39
 #: the fraction of the sphere's speed under which a node's arriving slip counts as carried with the sphere
 CARRIED_SLIP = 0.5
 #: channels of the contact scratch: 6 stress, kappa, mass weight, proximity dx - gap of the closest particle,
-#: 3 the surface vector sum_p V_p grad N_i (C_AREA: C_AREA + 3)
+#: 3 the surface vector sum_p V_p grad N_i (C_AREA: C_AREA + 3); then one channel kept from step to step (not
+#: scratch): the node's normal traction averaged over the hold (C_TRACTION, Pa; INTERFACE_BOUNDARY_LAYER_TRACTION)
 C_AREA = 9
-N_CBUF = 12
+C_TRACTION = 12
+N_CBUF = 13
 
 
 @njit(cache=True, inline="always")
@@ -211,6 +218,22 @@ def interface_shear(model, iparams, pressure, kappa):
     return min(tau, kappa)
 
 
+@njit(cache=True, inline="always")
+def held_traction(cbuf, node, traction, fresh, hold_steps):
+    """Update the node's normal traction averaged over the contact's hold, cbuf[node, C_TRACTION] (Pa).
+
+    ``traction``: this step's normal impulse over the node's surface share and dt (0 on a held step without a
+    push); ``fresh``: the node is pushed and was not in contact before, so the average starts at this step's
+    traction. Otherwise an exponential average over ``hold_steps`` steps: the contact rings at the elastic-wave
+    period and pushes a node on some steps only, so one step's traction is not the pressure the node carries,
+    its average over a few periods is (summed over the contact nodes, traction times share is the normal force).
+    """
+    if fresh:
+        cbuf[node, C_TRACTION] = traction
+    else:
+        cbuf[node, C_TRACTION] += (traction - cbuf[node, C_TRACTION]) / max(hold_steps, 1.0)
+
+
 @njit(cache=True)
 def surface_share(cbuf, node, mirror_plane):
     """The node's share of the material's surface, |sum_p V_p grad N_i|, m^2.
@@ -314,7 +337,7 @@ def sphere_contact(G, S, law, step, dt, out):
                 kap = cbuf[node, 6]
                 prox = cbuf[node, 8]
                 area = surface_share(cbuf, node, flags[node] == MIRROR)
-                for k in range(N_CBUF):
+                for k in range(C_TRACTION):
                     cbuf[node, k] = 0.0
                 m = grid_m[node]
                 dist = math.sqrt(d2)
@@ -336,6 +359,9 @@ def sphere_contact(G, S, law, step, dt, out):
                 jn = m * (vn_min - vn) if vn < vn_min else 0.0
                 if jn <= 0.0 and not held:
                     continue  # neither pushed now nor within the hold
+                if law.model == INTERFACE_BOUNDARY_LAYER_TRACTION:
+                    held_traction(cbuf, node, jn / (dt * area) if area > 0.0 else 0.0, jn > 0.0 and not held,
+                                  law.hold_steps)
                 if jn > 0.0:
                     last_push[node] = step
                 t0 = r0 - vn * n0
@@ -344,7 +370,10 @@ def sphere_contact(G, S, law, step, dt, out):
                 vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
                 if cw > 0.0:
                     inv = 1.0 / cw
-                    pressure = normal_pressure(n0, n1, n2, s0, s1, s2, s3, s4, s5) * inv
+                    if law.model == INTERFACE_BOUNDARY_LAYER_TRACTION:
+                        pressure = cbuf[node, C_TRACTION]
+                    else:
+                        pressure = normal_pressure(n0, n1, n2, s0, s1, s2, s3, s4, s5) * inv
                     kappa = kap * inv
                 else:
                     pressure = 0.0

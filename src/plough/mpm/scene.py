@@ -549,6 +549,10 @@ class Scene:
         _finite_positive("scene", "load_N", self.load_N, "N")
         if not isinstance(self.interface, ProportionalShear | ConstantShear | BoundaryLayerShear):
             raise ValueError(f"interface = {self.interface!r} is not an interface model")
+        if isinstance(self.interface, BoundaryLayerShear) and self.interface.pressure == "traction" \
+                and self.discretisation.contact == "particle":
+            raise ValueError("interface.pressure = 'traction' needs discretisation.contact 'grid_local' or 'grid' "
+                             "(the grid contact's nodal traction), not 'particle'")
         self._check_below_melting()
         self._check_fits()
 

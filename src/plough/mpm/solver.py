@@ -243,6 +243,8 @@ def interface_arrays(scene: Scene) -> tuple[int, np.ndarray]:
     if isinstance(itf, ConstantShear):
         return contact.INTERFACE_CONSTANT, np.array([itf.tau_Pa, 0.0])
     if isinstance(itf, BoundaryLayerShear):
+        if itf.pressure == "traction":
+            return contact.INTERFACE_BOUNDARY_LAYER_TRACTION, np.array([itf.Cp, itf.np])
         return contact.INTERFACE_BOUNDARY_LAYER, np.array([itf.Cp, itf.np])
     raise ValueError(f"interface = {itf!r} is unknown")
 

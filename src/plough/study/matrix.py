@@ -252,7 +252,8 @@ def _interface_key(d: dict[str, Any]) -> str:
         return f"const{fmt(d['H0_Pa'] / 1e6)}"
     if model == "proportional":
         return f"prop{fmt(d.get('f', 1.0))}"
-    return f"bl{fmt(d['Cp'])}-{fmt(d['np'])}"
+    # the pressure the MPM reads is named only where it is not the default, so the default's run ids stay
+    return f"bl{fmt(d['Cp'])}-{fmt(d['np'])}" + ("" if d.get("pressure", "particles") == "particles" else "-traction")
 
 
 def _interface(name: str, rp: dict[str, Any]) -> dict[str, Any]:
@@ -312,7 +313,8 @@ def real_point(real: dict[str, Any], system: str, load_N: float, radius_um: floa
     ``coating_thickness_um``), or its ``thickness_sweep`` or ``picture`` (``load_N``, ``radius_um``)."""
     spec = real["systems"][system]
     lub = real["lubricants"][spec["lubricant"]]
-    iface = {"model": "boundary_layer", "Cp": float(lub["Cp"]), "np": float(lub["np"])}
+    iface = {"model": "boundary_layer", "Cp": float(lub["Cp"]), "np": float(lub["np"]),
+             "pressure": str(lub.get("pressure", "particles"))}
     t = float(real["coating_thickness_um"] if thickness_um is None else thickness_um) if spec.get("coating") else 0.0
     mats = f"{spec['coating']}-on-{spec['substrate']}_t{fmt(t)}" if t > 0 else spec["substrate"]
     key = f"{mats}_{_interface_key(iface)}_r{fmt(radius_um)}_F{fmt(load_N)}"
