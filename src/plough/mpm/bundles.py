@@ -39,7 +39,7 @@ class GridData(NamedTuple):
     m: np.ndarray  # (nodes,) nodal mass, kg
     v: np.ndarray  # (nodes, 6) velocity after the step's forces 0:3 and before the internal force 3:6, m/s
     div: np.ndarray  # (nodes,) projected dilatation rate, 1/s
-    cbuf: np.ndarray  # (nodes, contact.N_CBUF) contact scratch: the near particles' stress, strength, surface
+    cbuf: np.ndarray  # (nodes, contact.N_CBUF) contact scratch (near particles: stress, strength, surface), traction
     last_push: np.ndarray  # (nodes,) int64 step of each node's last normal push by the sphere
 
 

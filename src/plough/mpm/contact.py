@@ -291,11 +291,12 @@ def _record_split(out, S, speed, area, tau, force, n, slip, where, dx):
 def sphere_contact(G, S, law, step, dt, out):
     """Impose the sphere on the nodes inside it and measure the reaction.
 
-    Reads G.m, G.flags, G.cbuf (from scatter_contact_stress; its entries are zeroed here), the sphere
-    (S.centre, S.radius, S.velocity) and the interface law (``law``,
+    Reads G.m, G.flags, G.cbuf (from scatter_contact_stress; its scratch entries, 0:C_TRACTION, are zeroed
+    here), the sphere (S.centre, S.radius, S.velocity) and the interface law (``law``,
     :class:`plough.mpm.bundles.ContactLaw`). Reads and writes the per-node contact memory G.last_push
     (the step a node's velocity was last cut by the normal projection): a node pushed at ``step``, or
-    within the last ``law.hold_steps`` steps, is in contact and carries interface shear. Writes G.v of
+    within the last ``law.hold_steps`` steps, is in contact and carries interface shear; with the traction
+    boundary layer also G.cbuf[:, C_TRACTION], the node's held traction (``held_traction``). Writes G.v of
     contact nodes and out[0:N_OUT] (see the OUT_* indices; OUT_SH_AREA on, the split of the interface shear by
     region and kind of node, are diagnostics: ``_record_split``). Serial: it visits only the box of nodes
     around the sphere. It works on them whatever the active zone: nodes outside the zone's range have no
