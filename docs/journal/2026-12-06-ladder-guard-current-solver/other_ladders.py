@@ -27,12 +27,18 @@ from plough.study.runfiles import load_run  # noqa: E402
 KEY = "zinc_bulk_bl0.32-0.95_r500_F11"
 
 
-def main(workdir: Path) -> None:
+def all_scenes() -> dict:
+    """The scene of every run the configs that made the run files name (run id -> scene dict)."""
     scenes: dict = {}
     config = ROOT / "config"
     for files in ([config / "config.yaml"], [config / "paper.yaml"], [config / "preview.yaml"],
                   [config / "config.yaml", Path(__file__).parent / "contact20.yaml"]):
         scenes |= matrix.all_runs(load_config(files, ROOT))
+    return scenes
+
+
+def main(workdir: Path) -> None:
+    scenes = all_scenes()
     solver = solver_fingerprint()
     runs = {}
     for rid, scene in scenes.items():

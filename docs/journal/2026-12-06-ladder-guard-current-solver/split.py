@@ -2,6 +2,8 @@
 
     python docs/journal/2026-12-06-ladder-guard-current-solver/split.py /work/guardrun
 
+(at 38e49d6: the run files carry that solver's fingerprint, which the check against this tree's solver needs.)
+
 Reads every run file of the guard points in the run directory (each checked against its scene and this tree's
 solver, as other_ladders.py does) and prints, per size, mu and its two parts (ploughing mu_pl, interface shear
 mu_sh), the nodes' summed surface share in contact (``contact_shear_area``) and the mean interface strength
@@ -20,10 +22,11 @@ import numpy as np
 
 ROOT = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(ROOT / "src"))
+sys.path.insert(0, str(Path(__file__).parent))
+
+from other_ladders import all_scenes  # noqa: E402
 
 from plough.fingerprint import solver_fingerprint  # noqa: E402
-from plough.study import matrix  # noqa: E402
-from plough.study.plan import load_config  # noqa: E402
 from plough.study.runfiles import load_run  # noqa: E402
 
 #: sizes whose expected contact radius is at least this many particles enter the spread
@@ -33,11 +36,7 @@ MIN_CONTACT_PARTICLES = 6.0
 def main(workdir: Path) -> None:
     guard = json.loads((ROOT / "benchmarks" / "results" / "ladder_guard.json").read_text())
     keys = [p["point"] for p in guard["points"]]
-    scenes: dict = {}
-    config = ROOT / "config"
-    for files in ([config / "config.yaml"], [config / "paper.yaml"], [config / "preview.yaml"],
-                  [config / "config.yaml", Path(__file__).parent / "contact20.yaml"]):
-        scenes |= matrix.all_runs(load_config(files, ROOT))
+    scenes = all_scenes()
     solver = solver_fingerprint()
     print(f"solver {solver}")
     for key in keys:
