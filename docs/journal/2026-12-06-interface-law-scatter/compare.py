@@ -6,7 +6,8 @@ Reads each point's runs with ``interface.pressure: particles`` (the main command
 directory) and with ``traction`` (``traction_runs.py``'s, named ``<point>_traction_h<h>.nc`` in the second), and
 prints per size mu, mu_pl, mu_sh and the mean interface strength (``contact_shear_capacity`` /
 ``contact_shear_area``, steady window), then each pressure's h -> 0 limit over the relative ladder's sizes
-(``benchmarks/ladder_guard.py``'s ``limit``) beside the analytical model's value (nominal pressure Fn / Axy).
+(``benchmarks/ladder_guard.py``'s ``limit``), and over the paper's 10 / 5 / 2.5 µm where
+those runs are there, beside the analytical model's value (nominal pressure Fn / Axy).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from plough.study.plan import load_config  # noqa: E402
 POINTS = {"zinc_bulk_bl0.32-0.95_r500_F7": (20.0, 10.0, 5.0),
           "zinc_coating-on-dx56_t15_bl0.32-0.95_r500_F4": (20.0, 10.0, 5.0),
           "zinc_bulk_bl0.32-0.95_r500_F11": (28.0, 14.0, 7.0)}
+PAPER = (10.0, 5.0, 2.5)
 
 
 def main(particles_dir: Path, traction_dir: Path) -> None:
@@ -41,7 +43,8 @@ def main(particles_dir: Path, traction_dir: Path) -> None:
         for pressure, pattern in (("particles", particles_dir / "results" / "runs" / f"{key}_h{{h}}.nc"),
                                   ("traction", traction_dir / f"{key}_traction_h{{h}}.nc")):
             vals: dict[str, list[float]] = {"mu": [], "mu_sh": [], "se": []}
-            for h in sorted({h for h in (28.0, 20.0, 14.0, 10.0, 7.0, 5.0)
+            paper: dict[float, tuple[float, float, float]] = {}
+            for h in sorted({h for h in (28.0, 20.0, 14.0, 10.0, 7.0, 5.0, 2.5)
                              if Path(str(pattern).format(h=f"{h:g}")).exists()}, reverse=True):
                 ds = xr.open_dataset(str(pattern).format(h=f"{h:g}"))
                 w = ds["in_steady_window"].values.astype(bool)
@@ -53,8 +56,14 @@ def main(particles_dir: Path, traction_dir: Path) -> None:
                     vals["mu"].append(float(ds.mu))
                     vals["mu_sh"].append(float(ds.mu_sh))
                     vals["se"].append(float(ds.mu_standard_error))
+                if h in PAPER:
+                    paper[h] = (float(ds.mu), float(ds.mu_sh), float(ds.mu_standard_error))
             limits[pressure] = {q: limit(ladder, vals[q], vals["se"]) for q in ("mu", "mu_sh")}
-        print(f"\nh -> 0 over {' / '.join(f'{h:g}' for h in ladder)} µm:")
+            if len(paper) == len(PAPER):  # the paper's ladder too, where its three runs are there
+                limits[f"{pressure}, paper's sizes"] = {
+                    q: limit(PAPER, [paper[h][i] for h in PAPER], [paper[h][2] for h in PAPER])
+                    for i, q in enumerate(("mu", "mu_sh"))}
+        print(f"\nh -> 0 over {' / '.join(f'{h:g}' for h in ladder)} µm (the paper's: 10 / 5 / 2.5 µm):")
         for pressure, lim in limits.items():
             print(f"- {pressure}: " + ", ".join(
                 f"{q} {v['value']:.4f} ± {v['uncertainty']:.4f} ({v['method']}; {v['value'] / ana[q]:.2f}x analytical)"
