@@ -621,3 +621,21 @@ def test_shear_split_adds_up_and_matches_the_nodes(model, iparams, ci):
                  (ct.OUT_LATERAL_AREA, ct.OUT_LATERAL_FX)):
         assert 0.0 <= out[a] <= out[ct.OUT_SH_AREA] * (1 + 1e-12)
         assert abs(out[f]) <= np.abs(fx[contact]).sum() * (1 + 1e-9)
+
+
+def test_held_traction_starts_afresh_and_averages_over_the_hold():
+    """A node's held traction: a fresh contact takes this step's traction; within the contact each step moves
+    the average 1 / hold_steps of the way to this step's traction (0 on a held step without a push)."""
+    cbuf = np.zeros((2, ct.N_CBUF))
+    cbuf[1, ct.C_TRACTION] = 5.0  # a stale value from an earlier contact of another node
+    ct.held_traction(cbuf, 0, 100.0, True, 4.0)
+    assert cbuf[0, ct.C_TRACTION] == 100.0
+    ct.held_traction(cbuf, 0, 0.0, False, 4.0)  # held, not pushed
+    assert cbuf[0, ct.C_TRACTION] == 75.0
+    ct.held_traction(cbuf, 0, 100.0, False, 4.0)
+    assert cbuf[0, ct.C_TRACTION] == 81.25
+    ct.held_traction(cbuf, 1, 20.0, True, 4.0)  # a new contact forgets the stale value
+    assert cbuf[1, ct.C_TRACTION] == 20.0
+    ct.held_traction(cbuf, 0, 50.0, False, 0.5)  # a hold under one step: this step's traction
+    assert cbuf[0, ct.C_TRACTION] == 50.0
+    assert np.all(cbuf[:, : ct.C_TRACTION] == 0.0)  # the scratch channels are not touched

@@ -63,7 +63,7 @@ class SphereData(NamedTuple):
 class ContactLaw(NamedTuple):
     """The interface shear law of eq. 8, the contact's hold and the particle contact's sweeps (plough.mpm.contact)."""
 
-    model: int  # INTERFACE_PROPORTIONAL / INTERFACE_CONSTANT / INTERFACE_BOUNDARY_LAYER
+    model: int  # INTERFACE_PROPORTIONAL / _CONSTANT / _BOUNDARY_LAYER / _BOUNDARY_LAYER_TRACTION
     params: np.ndarray  # (2,) the law's parameters (f; tau; Cp, np)
     hold_steps: float  # a node (or a particle) stays in contact this many steps after its last normal push
     sweeps: int = 4  # projected Gauss-Seidel sweeps of particle_contact over the touching particles

@@ -208,7 +208,8 @@ def scatter_contact_stress(P, G, S, Z, ray_local):
 
 @njit(cache=True)
 def interface_shear(model, iparams, pressure, kappa):
-    """Interface shear strength tau (Pa) of eq. 8 at one node, capped at kappa."""
+    """Interface shear strength tau (Pa) of eq. 8 at one node, capped at kappa; both boundary layers
+    (INTERFACE_BOUNDARY_LAYER and _TRACTION) take Cp P^np, they differ only in the ``pressure`` given."""
     if model == INTERFACE_PROPORTIONAL:
         tau = iparams[0] * kappa
     elif model == INTERFACE_CONSTANT:

@@ -25,10 +25,11 @@ from plough.mpm.scene import Scene
 #: run at 2 particles per cell and 2 threads the measured peak RSS of the reference scene is below it.
 BYTES_PER_PARTICLE = 400
 #: Bytes a grid node holds besides the per-thread P2G copies (plough.mpm.solver.Work: mass, 6 velocities,
-#: dilatation, 12 contact sums, last push, flags), and per thread (the P2G copy: 7 float64 channels).
+#: dilatation, 12 contact sums and the held traction, last push, flags), and per thread (the P2G copy: 7 float64
+#: channels).
 #: Counted apart because graded runs with a shallow fine zone have 0.2-0.25 of the uniform particle count on
 #: the same grid, and a cluster job's 8 threads multiply the copies.
-GRID_BYTES_PER_NODE = 169
+GRID_BYTES_PER_NODE = 177
 GRID_BYTES_PER_NODE_PER_THREAD = 56
 #: the threads a memory request allows for: the cluster profile's 8 (this machine runs 2)
 REQUEST_THREADS = 8
