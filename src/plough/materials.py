@@ -241,6 +241,7 @@ class ConstantShear:
 
 #: where the MPM reads the boundary layer's local contact pressure P (docs/model.md, section 3.7)
 BOUNDARY_LAYER_PRESSURES = ("particles", "traction")
+DEFAULT_BOUNDARY_LAYER_PRESSURE = BOUNDARY_LAYER_PRESSURES[0]
 
 
 @dataclass(frozen=True)
@@ -255,7 +256,7 @@ class BoundaryLayerShear:
 
     Cp: float
     np: float
-    pressure: str = "particles"
+    pressure: str = DEFAULT_BOUNDARY_LAYER_PRESSURE
 
     def __post_init__(self) -> None:
         _check_positive("BoundaryLayerShear", Cp=self.Cp)

@@ -315,6 +315,7 @@ def sphere_contact(G, S, law, step, dt, out):
     i0, i1, j0, j1, k0, k1 = _inside_box(origin, dx, shape, centre, radius + dx)
     r2 = (radius + dx) * (radius + dx)
     speed = math.sqrt(v_sphere[0] * v_sphere[0] + v_sphere[1] * v_sphere[1] + v_sphere[2] * v_sphere[2])
+    traction = law.model == INTERFACE_BOUNDARY_LAYER_TRACTION  # the boundary layer reads the held traction
     for i in range(i0, i1 + 1):
         px = origin[0] + i * dx - centre[0]
         for j in range(j0, j1 + 1):
@@ -361,7 +362,7 @@ def sphere_contact(G, S, law, step, dt, out):
                 jn = m * (vn_min - vn) if vn < vn_min else 0.0
                 if jn <= 0.0 and not held:
                     continue  # neither pushed now nor within the hold
-                if law.model == INTERFACE_BOUNDARY_LAYER_TRACTION:
+                if traction:
                     held_traction(cbuf, node, jn / (dt * area) if area > 0.0 else 0.0, jn > 0.0 and not held,
                                   law.hold_steps)
                 if jn > 0.0:
@@ -372,7 +373,7 @@ def sphere_contact(G, S, law, step, dt, out):
                 vt = math.sqrt(t0 * t0 + t1 * t1 + t2 * t2)
                 if cw > 0.0:
                     inv = 1.0 / cw
-                    if law.model == INTERFACE_BOUNDARY_LAYER_TRACTION:
+                    if traction:
                         pressure = cbuf[node, C_TRACTION]
                     else:
                         pressure = normal_pressure(n0, n1, n2, s0, s1, s2, s3, s4, s5) * inv

@@ -27,6 +27,7 @@ from typing import Any
 import numpy as np
 
 from plough.materials import (
+    DEFAULT_BOUNDARY_LAYER_PRESSURE,
     ConstantFlow,
     ConstantShear,
     Interface,
@@ -253,7 +254,8 @@ def _interface_key(d: dict[str, Any]) -> str:
     if model == "proportional":
         return f"prop{fmt(d.get('f', 1.0))}"
     # the pressure the MPM reads is named only where it is not the default, so the default's run ids stay
-    return f"bl{fmt(d['Cp'])}-{fmt(d['np'])}" + ("" if d.get("pressure", "particles") == "particles" else "-traction")
+    pressure = d.get("pressure", DEFAULT_BOUNDARY_LAYER_PRESSURE)
+    return f"bl{fmt(d['Cp'])}-{fmt(d['np'])}" + ("" if pressure == DEFAULT_BOUNDARY_LAYER_PRESSURE else f"-{pressure}")
 
 
 def _interface(name: str, rp: dict[str, Any]) -> dict[str, Any]:
@@ -314,7 +316,7 @@ def real_point(real: dict[str, Any], system: str, load_N: float, radius_um: floa
     spec = real["systems"][system]
     lub = real["lubricants"][spec["lubricant"]]
     iface = {"model": "boundary_layer", "Cp": float(lub["Cp"]), "np": float(lub["np"]),
-             "pressure": str(lub.get("pressure", "particles"))}
+             "pressure": str(lub.get("pressure", DEFAULT_BOUNDARY_LAYER_PRESSURE))}
     t = float(real["coating_thickness_um"] if thickness_um is None else thickness_um) if spec.get("coating") else 0.0
     mats = f"{spec['coating']}-on-{spec['substrate']}_t{fmt(t)}" if t > 0 else spec["substrate"]
     key = f"{mats}_{_interface_key(iface)}_r{fmt(radius_um)}_F{fmt(load_N)}"
