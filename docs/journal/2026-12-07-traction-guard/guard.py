@@ -20,14 +20,11 @@ import xarray as xr
 
 ROOT = Path(__file__).resolve().parents[3]
 sys.path.insert(0, str(ROOT / "benchmarks"))
+sys.path.insert(0, str(ROOT / "docs" / "journal" / "2026-12-06-interface-law-scatter"))
 
+# the three real-material guard points with their relative ladders, and the paper's sizes: the previous probe's
+from compare import PAPER, POINTS  # noqa: E402
 from ladder_guard import OUTPUTS, limit, verdicts  # noqa: E402
-
-#: the three real-material guard points: the relative ladder (config/config.yaml) and the paper's
-POINTS = {"zinc_bulk_bl0.32-0.95_r500_F7": (20.0, 10.0, 5.0),
-          "zinc_coating-on-dx56_t15_bl0.32-0.95_r500_F4": (20.0, 10.0, 5.0),
-          "zinc_bulk_bl0.32-0.95_r500_F11": (28.0, 14.0, 7.0)}
-PAPER = (10.0, 5.0, 2.5)
 
 
 def abbrev(method: str) -> str:
