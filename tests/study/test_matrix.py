@@ -342,12 +342,12 @@ def test_changing_a_parameter_changes_exactly_the_runs_that_use_it(config, runs,
     new = set(after) - set(runs)
     assert len(new) == len(users) and len(after) == len(runs)
     field = {"Cp": "Cp", "np": "np", "pressure": "pressure", "H0_MPa": "H0_Pa"}[path[-1]]
-    scale = 1e6 if field == "H0_Pa" else 1
+    scene_value = value * 1e6 if field == "H0_Pa" else value  # the scene's units: Pa
     by_rest = {}
     for rid in users:
         d = copy.deepcopy(runs[rid])
         d.pop("name")
-        d["interface"][field] = value * scale if field != "pressure" else value
+        d["interface"][field] = scene_value
         by_rest[repr(d)] = rid
     for rid in new:
         d = copy.deepcopy(after[rid])

@@ -2,8 +2,8 @@
 
     PYTHONPATH=src python docs/journal/2026-12-07-traction-guard/guard.py /work/guardrun /work/tractionrun
 
-The same verdicts as ``benchmarks/ladder_guard.py`` (its ``limit`` and ``verdicts``: each ladder's h -> 0 value of
-mu, mu_pl, mu_sh and dp with the runs' sampling errors in quadrature; agreement within the two uncertainties in
+The same verdicts as ``benchmarks/ladder_guard.py`` (its ``ladder_limits`` and ``verdicts``: each ladder's h -> 0
+value of mu, mu_pl, mu_sh and dp with the runs' sampling errors in quadrature; agreement within the two uncertainties in
 quadrature; the relative ladder's uncertainty no larger than the paper's), for ``interface.pressure: particles``
 (the main command's and the guard's runs, ``<run dir>/results/runs/<point>_h<h>.nc``) and ``traction``
 (``2026-12-06-interface-law-scatter/traction_runs.py``'s, ``<dir>/<point>_traction_h<h>.nc``). The run files are
@@ -24,7 +24,7 @@ sys.path.insert(0, str(ROOT / "docs" / "journal" / "2026-12-06-interface-law-sca
 
 # the three real-material guard points with their relative ladders, and the paper's sizes: the previous probe's
 from compare import PAPER, POINTS  # noqa: E402
-from ladder_guard import OUTPUTS, limit, verdicts  # noqa: E402
+from ladder_guard import OUTPUTS, ladder_limits, verdicts  # noqa: E402
 
 
 def abbrev(method: str) -> str:
@@ -33,14 +33,15 @@ def abbrev(method: str) -> str:
 
 
 def ladder(path_of, sizes: tuple[float, ...]) -> dict:
-    values: dict[str, list[float]] = {o: [] for o in OUTPUTS}
-    errors: dict[str, list[float]] = {o: [] for o in OUTPUTS}
-    for h in sizes:
-        ds = xr.open_dataset(path_of(h))
-        for o in OUTPUTS:
-            values[o].append(float(ds[o]))
-            errors[o].append(float(ds[f"{o}_standard_error"]) if f"{o}_standard_error" in ds else float("nan"))
-    return {o: limit(sizes, values[o], errors[o]) for o in OUTPUTS}
+    """Each output's limit over ``sizes``: ``ladder_guard.ladder_limits`` on the runs' values, read from the files
+    as they are (its ``read_runs`` would check them against today's solver)."""
+    ids = [str(path_of(h)) for h in sizes]
+    values = {}
+    for rid in ids:
+        ds = xr.open_dataset(rid)
+        values[rid] = {o: float(ds[o]) for o in OUTPUTS} | {
+            f"{o}_standard_error": float(ds[f"{o}_standard_error"]) for o in OUTPUTS if f"{o}_standard_error" in ds}
+    return ladder_limits(sizes, ids, values, two_sizes=False)
 
 
 def main(particles_dir: Path, traction_dir: Path) -> None:
