@@ -31,10 +31,45 @@ def test_synthetic_power_law_recovers_limit_and_order(sizes, p, c):
     assert not res.flagged
     assert res.value == pytest.approx(F0, abs=1e-10)
     assert res.order == pytest.approx(p, rel=1e-9)
-    # Roache's GCI of the finest solution, absolute form, Fs = 1.25.
+    # Roache's GCI of the finest solution, absolute form: Fs = 1.25 at the formal order 1; an
+    # observed order above it gets Fs = 3 with the order bounded to 1 (Oberkampf & Roy).
     r = sizes[1] / sizes[0]
     e21 = c * (sizes[0] ** p - sizes[1] ** p)
-    assert res.uncertainty == pytest.approx(1.25 * abs(e21) / (r**p - 1), rel=1e-9)
+    expected = 1.25 * abs(e21) / (r - 1) if p == 1.0 else 3.0 * abs(e21) / (r - 1)
+    assert res.uncertainty == pytest.approx(expected, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("p", "fs", "band_order"),
+    [
+        (1.09, 1.25, 1.09),  # within 10% of the formal order: Roache's asymptotic GCI
+        (0.91, 1.25, 0.91),
+        (1.12, 3.0, 1.0),  # just outside: Fs = 3, the order bounded to the formal one
+        (2.7, 3.0, 1.0),  # error cancellation between sizes must not shrink the band 5x
+        (0.7, 3.0, 0.7),  # below the formal order: Fs = 3 at the observed order
+        (0.5, 3.0, 0.5),
+    ],
+)
+def test_gci_safety_factor_follows_the_distance_of_the_observed_order_from_the_formal(p, fs, band_order):
+    h = SIZES["uniform"]
+    f = F0 + 0.02 * h**p
+    res = extrapolate(h, f)
+    assert res.method == Method.RICHARDSON
+    assert res.value == pytest.approx(F0, abs=1e-10)  # the value keeps the observed order
+    e21 = f[0] - f[1]
+    assert res.uncertainty == pytest.approx(fs * abs(e21) / (2.0**band_order - 1), rel=1e-9)
+    # the band covers the finest value and the value the bounded order would extrapolate to
+    assert res.uncertainty >= abs(res.value - f[0])
+    assert res.uncertainty >= abs(res.value - (f[0] + e21 / (2.0**band_order - 1)))
+
+
+def test_gci_band_judges_the_observed_order_against_the_assumed_one():
+    h = SIZES["uniform"]
+    f = F0 + 0.02 * h**2
+    formal_two = extrapolate(h, f, assumed_order=2.0)
+    e21 = f[0] - f[1]
+    assert formal_two.uncertainty == pytest.approx(1.25 * abs(e21) / 3.0, rel=1e-9)
+    assert extrapolate(h, f).uncertainty == pytest.approx(3.0 * abs(e21), rel=1e-9)
 
 
 def test_sizes_in_any_order():

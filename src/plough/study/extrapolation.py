@@ -14,7 +14,20 @@ non-constant refinement ratio (``p = ln(1/R) / ln r`` when ``r21 = r32 = r``). T
     uncertainty = Fs * |e21| / (r^p - 1)
 
 The uncertainty is Roache's grid convergence index of the finest solution written as an
-absolute error (``GCI_fine * |f1|``), with safety factor ``Fs = 1.25`` (three or more sizes).
+absolute error (``GCI_fine * |f1|``), with the safety factor and the order in ``r^p`` chosen by how
+far the observed order is from the formal one (``assumed_order``, 1 for plough's MPM), after
+Oberkampf & Roy (2010, sec. 8.7):
+
+* within 10% of it (``|p - p_f| <= 0.1 p_f``, the asymptotic range): ``Fs = 1.25`` with the observed
+  ``p`` (Roache's GCI as Celik et al. give it; Oberkampf & Roy use ``p_f`` here, which would narrow the
+  band where ``p < p_f``);
+* else ``Fs = 3`` with ``min(max(0.5, p), p_f)``: an observed order above the formal one (error
+  cancellation between sizes not yet in the asymptotic range) never narrows the band below what the
+  formal order gives, and one below it widens it.
+
+The value keeps the observed order; the band covers ``f1`` and the value a bounded order would give.
+Roache (J. Fluids Eng. 133 (2011) 115501) states the same reversion: where the observed order is not
+reasonable, use the theoretical one and ``Fs = 3`` rather than blindly ``Fs = 1.25``.
 
 The convergence is accepted as monotone only if ``R > 0`` and the observed order lies in
 ``order_bounds`` (default 0.5 to 4). For a constant ratio this is the classical test
@@ -40,7 +53,8 @@ get ``method = MISSING`` and NaN results.
 References: L.F. Richardson, Phil. Trans. R. Soc. A 210 (1911) 307; P.J. Roache, "Verification
 and Validation in Computational Science and Engineering", Hermosa (1998); I.B. Celik et al.,
 "Procedure for estimation and reporting of uncertainty due to discretization in CFD
-applications", J. Fluids Eng. 130 (2008) 078001.
+applications", J. Fluids Eng. 130 (2008) 078001; W.L. Oberkampf and C.J. Roy, "Verification and
+Validation in Scientific Computing", Cambridge University Press (2010), sec. 8.7.
 """
 
 from __future__ import annotations
@@ -57,8 +71,10 @@ if TYPE_CHECKING:
 
 __all__ = [
     "FLAG_MEANINGS",
+    "ASYMPTOTIC_ORDER_TOLERANCE",
     "SAFETY_FACTOR_THREE_OR_MORE",
     "SAFETY_FACTOR_TWO",
+    "SMALLEST_BAND_ORDER",
     "Extrapolation",
     "Method",
     "extrapolate",
@@ -67,9 +83,14 @@ __all__ = [
     "total_uncertainty",
 ]
 
-#: Roache's safety factors: 1.25 when the order is observed (three or more sizes), 3 when assumed.
+#: Roache's safety factors: 1.25 when three or more sizes observe the formal order, 3 when the order
+#: is assumed (two sizes) or the observed one is not the formal one (Oberkampf & Roy 2010).
 SAFETY_FACTOR_THREE_OR_MORE = 1.25
 SAFETY_FACTOR_TWO = 3.0
+#: Relative distance of the observed order from the formal one within which it counts as asymptotic.
+ASYMPTOTIC_ORDER_TOLERANCE = 0.1
+#: The smallest order the uncertainty band uses: a lower one would make the band arbitrarily wide.
+SMALLEST_BAND_ORDER = 0.5
 
 # Values equal to within a few ulps of their magnitude are treated as converged: differencing them
 # would only extrapolate rounding noise.
@@ -143,6 +164,17 @@ def _observed_order(
     return 0.5 * (p_lo + p_hi)
 
 
+def _gci_safety_factor_and_order(
+    p_obs: NDArray[np.float64], formal_order: float
+) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Roache's ``Fs`` and the order of the GCI band for observed orders ``p_obs`` (module docstring):
+    ``(1.25, p)`` within 10% of the formal order ``p_f``, else ``(3, min(max(0.5, p), p_f))``."""
+    asymptotic = np.abs(p_obs - formal_order) <= ASYMPTOTIC_ORDER_TOLERANCE * formal_order
+    fs = np.where(asymptotic, SAFETY_FACTOR_THREE_OR_MORE, SAFETY_FACTOR_TWO)
+    bounded = np.minimum(np.maximum(p_obs, SMALLEST_BAND_ORDER), formal_order)
+    return fs, np.where(asymptotic, p_obs, bounded)
+
+
 def _least_squares(
     h: NDArray[np.float64], f: NDArray[np.float64], q: float
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
@@ -186,9 +218,10 @@ def extrapolate(
     Args:
         h: particle sizes, 1-D, at least two distinct positive values, in any order.
         f: values; the last axis matches ``h``, leading axes are independent points.
-        assumed_order: order used when it cannot be observed (two sizes) and for the
-            least-squares fallback.
-        safety_factor: Roache's ``Fs``; default 1.25 for three or more sizes, 3 for two.
+        assumed_order: the formal order: used when the order cannot be observed (two sizes), for the
+            least-squares fallback, and as the reference the observed order is judged against.
+        safety_factor: Roache's ``Fs`` for every point; default 3 for two sizes, and for three or
+            more 1.25 where the observed order is within 10% of ``assumed_order``, else 3.
         order_bounds: inclusive range of observed orders accepted as asymptotic convergence.
 
     Returns:
@@ -204,9 +237,7 @@ def extrapolate(
     if not (0 < p_min < p_max < np.inf):
         raise ValueError(f"order_bounds must satisfy 0 < low < high < inf, got {order_bounds}")
     n = h.size
-    if safety_factor is None:
-        safety_factor = SAFETY_FACTOR_TWO if n == 2 else SAFETY_FACTOR_THREE_OR_MORE
-    if not (np.isfinite(safety_factor) and safety_factor > 0):
+    if safety_factor is not None and not (np.isfinite(safety_factor) and safety_factor > 0):
         raise ValueError(f"safety_factor must be finite and > 0, got {safety_factor}")
 
     sort = np.argsort(h)
@@ -239,7 +270,8 @@ def extrapolate(
         todo = ~converged
         gain = 1.0 / (r21**assumed_order - 1.0)
         v[todo] = f1[todo] + e21[todo] * gain
-        u[todo] = safety_factor * np.abs(e21[todo]) * gain
+        fs = SAFETY_FACTOR_TWO if safety_factor is None else safety_factor
+        u[todo] = fs * np.abs(e21[todo]) * gain
         p[todo] = assumed_order
         m[todo] = Method.TWO_SIZES_ASSUMED_ORDER
     else:
@@ -255,9 +287,11 @@ def extrapolate(
         inside = (log_ratio >= bounds[0] - _BOUND_SLACK) & (log_ratio <= bounds[1] + _BOUND_SLACK)
         rich = idx[inside]
         p_obs = _observed_order(log_ratio[inside], a, b, p_min, p_max)
-        gain = 1.0 / (r21**p_obs - 1.0)
-        v[rich] = f1[rich] + e21[rich] * gain
-        u[rich] = safety_factor * np.abs(e21[rich]) * gain
+        v[rich] = f1[rich] + e21[rich] / (r21**p_obs - 1.0)
+        fs, p_band = _gci_safety_factor_and_order(p_obs, assumed_order)
+        if safety_factor is not None:
+            fs = np.full_like(p_obs, safety_factor)
+        u[rich] = fs * np.abs(e21[rich]) / (r21**p_band - 1.0)
         p[rich] = p_obs
         m[rich] = Method.RICHARDSON
 
@@ -393,10 +427,14 @@ def extrapolate_dataarray(
     coords = {k: c for k, c in da.coords.items() if dim not in c.dims}
     name = da.attrs.get("long_name", da.name if da.name is not None else "quantity")
     units = {"units": da.attrs["units"]} if "units" in da.attrs else {}
-    n = h.size
-    fs = safety_factor
-    if fs is None:
-        fs = SAFETY_FACTOR_TWO if n == 2 else SAFETY_FACTOR_THREE_OR_MORE
+    if safety_factor is not None:
+        fs_attrs = {"safety_factor": float(safety_factor)}
+    elif h.size == 2:
+        fs_attrs = {"safety_factor": SAFETY_FACTOR_TWO}
+    else:
+        fs_attrs = {"safety_factor": SAFETY_FACTOR_THREE_OR_MORE,
+                    "safety_factor_outside_asymptotic_range": SAFETY_FACTOR_TWO,
+                    "asymptotic_order_tolerance": ASYMPTOTIC_ORDER_TOLERANCE}
     codes = np.array([int(m) for m in Method], dtype=np.int8)
     variables = {
         "value": (dims, res.value, {"long_name": f"{name} extrapolated to {dim} -> 0", **units}),
@@ -427,13 +465,14 @@ def extrapolate_dataarray(
         ),
     }
     attrs = {
-        "extrapolation": "Richardson with observed order and Roache GCI (Celik et al. 2008); "
-        "least-squares fallback in h**assumed_order",
+        "extrapolation": "Richardson with observed order and Roache GCI (Celik et al. 2008), safety factor 1.25 "
+        "where the observed order is within 10% of assumed_order, else 3 with the order bounded by 0.5 and "
+        "assumed_order (Oberkampf and Roy 2010); least-squares fallback in h**assumed_order",
         "extrapolated_dim": dim,
         "sizes": res.h,
         "assumed_order": float(assumed_order),
         "order_bounds": np.asarray(order_bounds, dtype=float),
-        "safety_factor": float(fs),
+        **fs_attrs,
     }
     if da.name is not None:
         attrs["source_variable"] = str(da.name)
