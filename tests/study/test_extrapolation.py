@@ -42,7 +42,9 @@ def test_synthetic_power_law_recovers_limit_and_order(sizes, p, c):
 @pytest.mark.parametrize(
     ("p", "fs", "band_order"),
     [
-        (1.09, 1.25, 1.09),  # within 10% of the formal order: Roache's asymptotic GCI
+        (1.09, 1.25, 1.0),  # within 10% of the formal order: Roache's asymptotic Fs, the order at most 1
+        (1.1, 1.25, 1.0),  # on the edges of the 10% alike
+        (0.9, 1.25, 0.9),
         (0.91, 1.25, 0.91),
         (1.12, 3.0, 1.0),  # just outside: Fs = 3, the order bounded to the formal one
         (2.7, 3.0, 1.0),  # error cancellation between sizes must not shrink the band 5x
@@ -58,9 +60,21 @@ def test_gci_safety_factor_follows_the_distance_of_the_observed_order_from_the_f
     assert res.value == pytest.approx(F0, abs=1e-10)  # the value keeps the observed order
     e21 = f[0] - f[1]
     assert res.uncertainty == pytest.approx(fs * abs(e21) / (2.0**band_order - 1), rel=1e-9)
-    # the band covers the finest value and the value the bounded order would extrapolate to
-    assert res.uncertainty >= abs(res.value - f[0])
-    assert res.uncertainty >= abs(res.value - (f[0] + e21 / (2.0**band_order - 1)))
+
+
+@pytest.mark.parametrize("sizes", SIZES.values(), ids=SIZES.keys())
+@pytest.mark.parametrize("p", [0.15, 0.4, 0.8, 0.95, 1.0, 1.05, 1.3, 2.0, 3.5, 5.5])
+@pytest.mark.parametrize("c", [0.02, -0.3])
+def test_gci_band_covers_the_finest_value_and_the_formal_order_extrapolation(sizes, p, c):
+    # orders outside the default bounds too: the band must not narrow below the formal order's however far p is
+    f = F0 + c * sizes**p
+    res = extrapolate(sizes, f, order_bounds=(0.1, 6.0))
+    assert res.method == Method.RICHARDSON
+    e21 = f[0] - f[1]
+    formal = f[0] + e21 / (sizes[1] / sizes[0] - 1)
+    assert res.uncertainty >= abs(res.value - f[0]) * (1 - 1e-12)
+    if abs(p - 1) > 0.1:
+        assert res.uncertainty >= abs(res.value - formal) * (1 - 1e-12)
 
 
 def test_gci_band_judges_the_observed_order_against_the_assumed_one():
@@ -70,6 +84,13 @@ def test_gci_band_judges_the_observed_order_against_the_assumed_one():
     e21 = f[0] - f[1]
     assert formal_two.uncertainty == pytest.approx(1.25 * abs(e21) / 3.0, rel=1e-9)
     assert extrapolate(h, f).uncertainty == pytest.approx(3.0 * abs(e21), rel=1e-9)
+
+
+def test_a_given_safety_factor_is_the_plain_gci_at_the_observed_order():
+    h = SIZES["uniform"]
+    f = F0 + 0.02 * h**2
+    e21 = f[0] - f[1]
+    assert extrapolate(h, f, safety_factor=1.25).uncertainty == pytest.approx(1.25 * abs(e21) / 3.0, rel=1e-9)
 
 
 def test_sizes_in_any_order():
@@ -330,6 +351,9 @@ def test_dataarray_wrapper():
     assert ds.flagged.dtype == bool
     np.testing.assert_array_equal(ds.attrs["sizes"], [2.5, 5.0, 10.0])
     assert ds.attrs["safety_factor"] == 1.25
+    assert ds.attrs["safety_factor_outside_asymptotic_range"] == 3.0
+    assert ds.attrs["asymptotic_order_tolerance"] == 0.1
+    assert "Oberkampf" in ds.attrs["extrapolation"]
 
     direct = extrapolate(h, np.moveaxis(f, 0, -1))
     np.testing.assert_array_equal(ds.value.values, direct.value)

@@ -25,7 +25,9 @@ import xarray as xr
 from plough.study.extrapolation import SAFETY_FACTOR_THREE_OR_MORE, Method, extrapolate
 
 
-def limits(directory: Path, restamp: Path | None = None) -> list[dict]:
+def limits(directory: Path, restamp: Path | None = None) -> list[dict[str, object]]:
+    """Every Richardson limit of the datasets under ``directory``: its order and the ratios after / before of
+    its GCI and of its bar with the sampling error; with ``restamp``, the datasets written there with today's."""
     out = []
     for path in sorted(directory.glob("fig*.nc")):
         with xr.load_dataset(path) as ds:
@@ -42,7 +44,8 @@ def limits(directory: Path, restamp: Path | None = None) -> list[dict]:
                     order = np.argsort(h)
                     h, f = h[order], f[order]
                     ex = extrapolate(h, f)
-                    before = SAFETY_FACTOR_THREE_OR_MORE * abs(f[0] - f[1]) / ((h[1] / h[0]) ** float(ex.order) - 1)
+                    # the rule before 2026-12-07: Fs = 1.25 at the observed order (a given Fs is that)
+                    before = float(extrapolate(h, f, safety_factor=SAFETY_FACTOR_THREE_OR_MORE).uncertainty)
                     stored = float(ds[f"{output}_h0_uncertainty{suffix}"].isel(sel))
                     if not np.isclose(stored, before, rtol=1e-9, atol=0):
                         raise SystemExit(f"{path.name} {output}{suffix} {sel}: stored {stored} != {before}")
@@ -59,6 +62,7 @@ def limits(directory: Path, restamp: Path | None = None) -> list[dict]:
 
 
 def main(directory: Path, restamp: Path | None) -> None:
+    """Print the ratios per output."""
     if restamp is not None:
         restamp.mkdir(parents=True, exist_ok=True)
     table = limits(directory, restamp)

@@ -11,23 +11,21 @@ non-constant refinement ratio (``p = ln(1/R) / ln r`` when ``r21 = r32 = r``). T
 ``r = h2 / h1``::
 
     value       = f1 + e21 / (r^p - 1)
-    uncertainty = Fs * |e21| / (r^p - 1)
+    uncertainty = Fs * |e21| / (r^q - 1),   q = min(p, p_f)
 
 The uncertainty is Roache's grid convergence index of the finest solution written as an
-absolute error (``GCI_fine * |f1|``), with the safety factor and the order in ``r^p`` chosen by how
-far the observed order is from the formal one (``assumed_order``, 1 for plough's MPM), after
-Oberkampf & Roy (2010, sec. 8.7):
-
-* within 10% of it (``|p - p_f| <= 0.1 p_f``, the asymptotic range): ``Fs = 1.25`` with the observed
-  ``p`` (Roache's GCI as Celik et al. give it; Oberkampf & Roy use ``p_f`` here, which would narrow the
-  band where ``p < p_f``);
-* else ``Fs = 3`` with ``min(max(0.5, p), p_f)``: an observed order above the formal one (error
-  cancellation between sizes not yet in the asymptotic range) never narrows the band below what the
-  formal order gives, and one below it widens it.
-
-The value keeps the observed order; the band covers ``f1`` and the value a bounded order would give.
+absolute error (``GCI_fine * |f1|``), after Oberkampf & Roy (2010, sec. 8.7): the safety factor is
+``Fs = 1.25`` where the observed order lies within 10% of the formal one ``p_f`` (``assumed_order``,
+1 for plough's MPM; ``|p - p_f| <= 0.1 p_f``, the asymptotic range), else ``Fs = 3``; and the band's
+order ``q`` never exceeds ``p_f``, so that an observed order above it (error cancellation between sizes
+not yet in the asymptotic range) does not narrow the band below what the formal order gives. Oberkampf &
+Roy take ``q = p_f`` inside the 10% and floor ``q`` at 0.5 outside it; ``min(p, p_f)`` is never narrower
+than either, and ``order_bounds`` (from 0.5 by default) already keeps ``p`` off the floor.
 Roache (J. Fluids Eng. 133 (2011) 115501) states the same reversion: where the observed order is not
 reasonable, use the theoretical one and ``Fs = 3`` rather than blindly ``Fs = 1.25``.
+
+The value keeps the observed order; since ``Fs >= 1`` and ``q <= p`` the band covers ``f1``, and
+outside the 10% also the value the formal order would extrapolate to.
 
 The convergence is accepted as monotone only if ``R > 0`` and the observed order lies in
 ``order_bounds`` (default 0.5 to 4). For a constant ratio this is the classical test
@@ -70,11 +68,10 @@ if TYPE_CHECKING:
     import xarray as xr
 
 __all__ = [
-    "FLAG_MEANINGS",
     "ASYMPTOTIC_ORDER_TOLERANCE",
+    "FLAG_MEANINGS",
     "SAFETY_FACTOR_THREE_OR_MORE",
     "SAFETY_FACTOR_TWO",
-    "SMALLEST_BAND_ORDER",
     "Extrapolation",
     "Method",
     "extrapolate",
@@ -89,8 +86,6 @@ SAFETY_FACTOR_THREE_OR_MORE = 1.25
 SAFETY_FACTOR_TWO = 3.0
 #: Relative distance of the observed order from the formal one within which it counts as asymptotic.
 ASYMPTOTIC_ORDER_TOLERANCE = 0.1
-#: The smallest order the uncertainty band uses: a lower one would make the band arbitrarily wide.
-SMALLEST_BAND_ORDER = 0.5
 
 # Values equal to within a few ulps of their magnitude are treated as converged: differencing them
 # would only extrapolate rounding noise.
@@ -167,12 +162,12 @@ def _observed_order(
 def _gci_safety_factor_and_order(
     p_obs: NDArray[np.float64], formal_order: float
 ) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
-    """Roache's ``Fs`` and the order of the GCI band for observed orders ``p_obs`` (module docstring):
-    ``(1.25, p)`` within 10% of the formal order ``p_f``, else ``(3, min(max(0.5, p), p_f))``."""
-    asymptotic = np.abs(p_obs - formal_order) <= ASYMPTOTIC_ORDER_TOLERANCE * formal_order
+    """Roache's ``Fs`` and the order ``q`` of the GCI band for observed orders ``p_obs`` (module
+    docstring): ``Fs`` 1.25 within 10% of the formal order ``p_f``, else 3; ``q = min(p, p_f)``."""
+    # the slack keeps an order on either edge of the 10% inside it alike (|1.1 - 1| > 0.1 in binary)
+    asymptotic = np.abs(p_obs - formal_order) <= ASYMPTOTIC_ORDER_TOLERANCE * formal_order + _BOUND_SLACK
     fs = np.where(asymptotic, SAFETY_FACTOR_THREE_OR_MORE, SAFETY_FACTOR_TWO)
-    bounded = np.minimum(np.maximum(p_obs, SMALLEST_BAND_ORDER), formal_order)
-    return fs, np.where(asymptotic, p_obs, bounded)
+    return fs, np.minimum(p_obs, formal_order)
 
 
 def _least_squares(
@@ -220,8 +215,10 @@ def extrapolate(
         f: values; the last axis matches ``h``, leading axes are independent points.
         assumed_order: the formal order: used when the order cannot be observed (two sizes), for the
             least-squares fallback, and as the reference the observed order is judged against.
-        safety_factor: Roache's ``Fs`` for every point; default 3 for two sizes, and for three or
-            more 1.25 where the observed order is within 10% of ``assumed_order``, else 3.
+        safety_factor: Roache's ``Fs`` for every point, with the observed order in ``r^p`` (Celik et
+            al.'s GCI); by default 3 for two sizes, and for three or more the rule of the module
+            docstring (1.25 within 10% of ``assumed_order``, else 3, the band's order at most
+            ``assumed_order``).
         order_bounds: inclusive range of observed orders accepted as asymptotic convergence.
 
     Returns:
@@ -288,10 +285,11 @@ def extrapolate(
         rich = idx[inside]
         p_obs = _observed_order(log_ratio[inside], a, b, p_min, p_max)
         v[rich] = f1[rich] + e21[rich] / (r21**p_obs - 1.0)
-        fs, p_band = _gci_safety_factor_and_order(p_obs, assumed_order)
-        if safety_factor is not None:
-            fs = np.full_like(p_obs, safety_factor)
-        u[rich] = fs * np.abs(e21[rich]) / (r21**p_band - 1.0)
+        if safety_factor is None:
+            fs, q = _gci_safety_factor_and_order(p_obs, assumed_order)
+        else:  # a given Fs: Roache's GCI as Celik et al. state it, at the observed order
+            fs, q = safety_factor, p_obs
+        u[rich] = fs * np.abs(e21[rich]) / (r21**q - 1.0)
         p[rich] = p_obs
         m[rich] = Method.RICHARDSON
 
@@ -427,11 +425,17 @@ def extrapolate_dataarray(
     coords = {k: c for k, c in da.coords.items() if dim not in c.dims}
     name = da.attrs.get("long_name", da.name if da.name is not None else "quantity")
     units = {"units": da.attrs["units"]} if "units" in da.attrs else {}
+    # what the uncertainty was made with: a given Fs, the two-size rule, or the rule of the module docstring
     if safety_factor is not None:
+        gci = f"safety factor {safety_factor:g} at the observed order"
         fs_attrs = {"safety_factor": float(safety_factor)}
     elif h.size == 2:
+        gci = f"two sizes: safety factor {SAFETY_FACTOR_TWO:g} at assumed_order"
         fs_attrs = {"safety_factor": SAFETY_FACTOR_TWO}
     else:
+        gci = (f"safety factor {SAFETY_FACTOR_THREE_OR_MORE:g} where the observed order is within "
+               f"{ASYMPTOTIC_ORDER_TOLERANCE:.0%} of assumed_order, else {SAFETY_FACTOR_TWO:g}, the band's order at "
+               "most assumed_order (Oberkampf and Roy 2010)")
         fs_attrs = {"safety_factor": SAFETY_FACTOR_THREE_OR_MORE,
                     "safety_factor_outside_asymptotic_range": SAFETY_FACTOR_TWO,
                     "asymptotic_order_tolerance": ASYMPTOTIC_ORDER_TOLERANCE}
@@ -465,9 +469,8 @@ def extrapolate_dataarray(
         ),
     }
     attrs = {
-        "extrapolation": "Richardson with observed order and Roache GCI (Celik et al. 2008), safety factor 1.25 "
-        "where the observed order is within 10% of assumed_order, else 3 with the order bounded by 0.5 and "
-        "assumed_order (Oberkampf and Roy 2010); least-squares fallback in h**assumed_order",
+        "extrapolation": f"Richardson with observed order and Roache GCI (Celik et al. 2008), {gci}; "
+        "least-squares fallback in h**assumed_order",
         "extrapolated_dim": dim,
         "sizes": res.h,
         "assumed_order": float(assumed_order),

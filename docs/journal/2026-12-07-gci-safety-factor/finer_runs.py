@@ -1,6 +1,6 @@
 """Do the h -> 0 bars of three sizes cover the finer runs? The GCI's safety factor before and after (one-off probe).
 
-    PYTHONPATH=src python docs/journal/2026-12-07-gci-safety-factor/coverage.py /work/guardrun/results/runs \
+    PYTHONPATH=src python docs/journal/2026-12-07-gci-safety-factor/finer_runs.py /work/guardrun/results/runs \
         /work/tractionrun /work/lawprobe
 
 Every point with at least four sizes in the given directories (run files ``<point>_h<h>.nc``, read as they are) gives
@@ -10,8 +10,8 @@ limit, in quadrature) is set against every run finer than the triple: z = |finer
 run's own standard error). Where three sizes converge at their order, a finer run lies between the finest of them
 and the limit, inside any bar at least as wide as the extrapolation distance, so z <= 1; z > 1 says the bar claims
 more than the runs bear out. ``before``: Roache's Fs = 1.25 with the observed order for every Richardson limit (the
-rule to 2026-12-07); ``after``: today's (Fs = 1.25 within 10% of the formal order 1, else 3 with the order bounded
-by 0.5 and 1). The fallbacks' bars are the same under both. Triples overlap and most come from one point (the zinc
+rule to 2026-12-07); ``after``: today's (Fs = 1.25 within 10% of the formal order 1, else 3; the band's
+order at most 1). The fallbacks' bars are the same under both. Triples overlap and most come from one point (the zinc
 block at 11 N, eight sizes): the counts describe these runs, not a population.
 """
 
@@ -26,6 +26,9 @@ import numpy as np
 import xarray as xr
 
 from plough.study.extrapolation import SAFETY_FACTOR_THREE_OR_MORE, Method, extrapolate, sampling_error
+
+# the rule before 2026-12-07: Roache's Fs = 1.25 at the observed order for every Richardson limit (a given Fs is that)
+BEFORE = {"safety_factor": SAFETY_FACTOR_THREE_OR_MORE}
 
 OUTPUTS = ("mu", "mu_pl", "mu_sh", "dp")
 
@@ -45,15 +48,9 @@ def load(directory: Path) -> dict[str, dict[float, dict[str, float]]]:
     return points
 
 
-def bar_before(h: np.ndarray, f: np.ndarray, ex) -> float:
-    """The GCI as it was: Fs = 1.25 with the observed order for every Richardson limit."""
-    if ex.method != Method.RICHARDSON:
-        return float(ex.uncertainty)
-    r, p = h[1] / h[0], float(ex.order)
-    return SAFETY_FACTOR_THREE_OR_MORE * abs(f[0] - f[1]) / (r**p - 1)
-
-
-def rows(directories: list[Path]) -> list[dict]:
+def rows(directories: list[Path]) -> list[dict[str, object]]:
+    """One row per point, triple of sizes with one ratio, output and run finer than the triple: the limit's
+    method and order and the finer run's z under the rule before and today's."""
     out = []
     for directory in directories:
         for key, runs in load(directory).items():
@@ -70,18 +67,20 @@ def rows(directories: list[Path]) -> list[dict]:
                     f = np.array([runs[s][o] for s in triple])
                     se = np.array([runs[s][f"{o}_se"] for s in triple])
                     ex = extrapolate(h, f)
+                    bar_before = float(extrapolate(h, f, **BEFORE).uncertainty)
                     s = float(np.nan_to_num(sampling_error(h, f, se)))
                     for x in finer:
                         miss = abs(runs[x][o] - float(ex.value))
                         own = float(np.nan_to_num(runs[x][f"{o}_se"]))
                         out.append({"point": key, "triple": triple, "output": o, "finer": x,
                                     "method": Method(int(ex.method)).name.lower(), "order": float(ex.order),
-                                    "z_before": miss / np.hypot(np.hypot(bar_before(h, f, ex), s), own),
+                                    "z_before": miss / np.hypot(np.hypot(bar_before, s), own),
                                     "z_after": miss / np.hypot(np.hypot(float(ex.uncertainty), s), own)})
     return out
 
 
 def main(directories: list[Path]) -> None:
+    """Print the coverage by kind of limit, then every Richardson case."""
     table = rows(directories)
     print("| limits | triples x finer runs | covered (z <= 1) before | after | largest z before | after |")
     print("|---|---|---|---|---|---|")
