@@ -1,12 +1,13 @@
-"""What the main command's figures rest on: per MPM figure dataset (benchmarks/results/main/figNN.nc) and panel
-(the variables' suffix: none, _a / _b, _t / _bulk), how many points have an h -> 0 value of mu, by which
+"""What the main command's figures rest on: per MPM figure dataset (benchmarks/results/main_octave/figNN.nc; the
+current main command's in benchmarks/results/main) and panel (the variables' suffix: none, _a / _b, _t / _bulk),
+how many points have an h -> 0 value of mu, by which
 extrapolation method, how many of mu's and dp's are flagged (a fallback from Richardson), how many of the points'
 runs are not steady, the median relative uncertainty of mu at h -> 0, and the h -> 0 values of mu and dp against
 the analytical model's (the range of their ratio, and at how many points the analytical value lies within the
 h -> 0 value's uncertainty). Figs. 11 and 13, 15 and 20, 16, 21 and
 22 share their runs; Fig. 22's MPM points are Fig. 16's.
 
-    PYTHONPATH=src python figures_quality.py benchmarks/results/main
+    PYTHONPATH=src python figures_quality.py benchmarks/results/main_octave
 """
 import argparse
 from pathlib import Path
