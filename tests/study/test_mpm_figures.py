@@ -224,6 +224,7 @@ def test_fig15_per_size_values_extrapolation_and_analytical(smoke_dataset, tmp_p
     assert list(ds["h"].values) == sorted(SIZES, reverse=True)
     assert ds["dp_h0"].dims == ("material", "load_N")
     assert ds["dp_h0_method"].attrs["flag_meanings"].split()[Method.LEAST_SQUARES] == "least_squares"
+    assert "Oberkampf" in ds["mu_h0_uncertainty"].attrs["comment"]  # the file says which rule made its bars
     r1 = float(real["ball_radii_um"][0])
     substrates = {"zinc_block": "zinc_bulk", "steel": "dx56"}
     n_noisy = 0

@@ -150,6 +150,10 @@ def _panel_dataset(panel: matrix.Panel, sizes_um: tuple[float, ...], runs: Mappi
                 var = var.astype(np.int8)
             if field == "order":
                 var.attrs["allow_missing"] = 1  # NaN: undefined order of an exactly converged point
+            if field == "uncertainty":  # which rule made the bars, in the file itself
+                var.attrs["comment"] = ex.attrs["extrapolation"] + (
+                    f"; from two sizes where the finest run was skipped or failed: {ex_coarse.attrs['extrapolation']}"
+                    if two_sizes.any() else "")
             out[name] = var
         se = errors.get(f"{o}_standard_error")
         if se is not None and np.isfinite(se).any():
