@@ -90,9 +90,11 @@ def main(run_dir: Path, out_dir: Path, config_path: Path, solver: str | None) ->
     out_dir.mkdir(parents=True, exist_ok=True)
     not_needed = not_needed_runs(run_dir, config)
     figures = ("fig03", "fig04", *matrix.MPM_FIGURES, "fig22")
-    runs = {f: [r for r in matrix.figure_runs(config, "fig21" if f == "fig22" else f) if r not in not_needed]
-            for f in figures if f not in ("fig03", "fig04")}
-    every = sorted({run_dir / "results" / "runs" / f"{r}.nc" for ids in runs.values() for r in ids})
+    # each MPM figure's runs (Fig. 22 draws Fig. 21's points)
+    runs = {f: matrix.figure_runs(config, "fig21" if f == "fig22" else f) for f in figures
+            if f not in ("fig03", "fig04")}
+    every = sorted({run_dir / "results" / "runs" / f"{r}.nc" for ids in runs.values() for r in ids
+                    if r not in not_needed})
     solver, commit = runs_fingerprint(every, solver)
     with tempfile.TemporaryDirectory() as copies:
         for figure in figures:
@@ -100,9 +102,8 @@ def main(run_dir: Path, out_dir: Path, config_path: Path, solver: str | None) ->
                 ds = analytical_figures.build_dataset(figure, config[analytical_figures.config_section(figure)])
             else:
                 paths = {r: with_pressure_key(run_dir / "results" / "runs" / f"{r}.nc", Path(copies))
-                         for r in runs[figure]}
-                gated_off = [r for r in matrix.figure_runs(config, "fig21" if figure == "fig22" else figure)
-                             if r in not_needed]
+                         for r in runs[figure] if r not in not_needed}
+                gated_off = [r for r in runs[figure] if r in not_needed]
                 ds = mpm_figures.build_dataset(config, figure, paths, solver=solver, not_needed=gated_off)
                 ds.attrs.update(runs_solver_fingerprint=solver, runs_git_commit=commit)
             write_netcdf_atomic(ds, out_dir / f"{figure}.nc")
